@@ -1,0 +1,152 @@
+// Runtime access to the camera models by COLMAP model id.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camera_models/double_sphere.h"
+#include "camera_models/equirectangular.h"
+#include "camera_models/eucm.h"
+#include "camera_models/perspective.h"
+#include "camera_models/unified_omni.h"
+
+namespace sphera {
+
+enum class ModelId : int {
+  kPinhole = PinholeModel::kModelId,                  // 1
+  kOpenCV = OpenCVModel::kModelId,                    // 4
+  kEUCM = EUCMModel::kModelId,                        // 16
+  kEquirectangular = EquirectangularModel::kModelId,  // 17
+  kUnifiedOmni = UnifiedOmniModel::kModelId,          // 64
+  kDoubleSphere = DoubleSphereModel::kModelId,        // 65
+};
+
+struct ModelInfo {
+  int id;
+  const char* name;
+  int num_params;
+  const char* params_info;
+};
+
+namespace internal {
+
+template <typename Model>
+ModelInfo InfoOf() {
+  return {Model::kModelId, Model::kModelName, Model::kNumParams,
+          Model::kParamsInfo};
+}
+
+// Calls func(Model{}) for the model with the given id; the single place that
+// maps ids to model types.
+template <typename Func>
+decltype(auto) VisitModel(int model_id, Func&& func) {
+  switch (model_id) {
+    case PinholeModel::kModelId:
+      return func(PinholeModel{});
+    case OpenCVModel::kModelId:
+      return func(OpenCVModel{});
+    case EUCMModel::kModelId:
+      return func(EUCMModel{});
+    case EquirectangularModel::kModelId:
+      return func(EquirectangularModel{});
+    case UnifiedOmniModel::kModelId:
+      return func(UnifiedOmniModel{});
+    case DoubleSphereModel::kModelId:
+      return func(DoubleSphereModel{});
+    default:
+      throw std::invalid_argument("Unknown camera model id " +
+                                  std::to_string(model_id));
+  }
+}
+
+// Guards the raw-pointer model functions against short parameter vectors.
+template <typename Model>
+void RequireParamCount(const std::vector<double>& params) {
+  const std::string error = CheckParamCount(
+      Model::kModelName, Model::kParamsInfo, Model::kNumParams, params.size());
+  if (!error.empty()) throw std::invalid_argument(error);
+}
+
+}  // namespace internal
+
+// The models added by SPHERA (ids 16, 17, 64, 65).
+inline const std::vector<ModelInfo>& SphereModels() {
+  static const std::vector<ModelInfo> models = {
+      internal::InfoOf<EUCMModel>(), internal::InfoOf<EquirectangularModel>(),
+      internal::InfoOf<UnifiedOmniModel>(),
+      internal::InfoOf<DoubleSphereModel>()};
+  return models;
+}
+
+inline bool IsSphereModel(int model_id) {
+  for (const ModelInfo& info : SphereModels()) {
+    if (info.id == model_id) return true;
+  }
+  return false;
+}
+
+// Id of a model known to this library (all six), or -1.
+inline int ModelIdFromName(const std::string& name) {
+  for (const ModelInfo& info :
+       {internal::InfoOf<PinholeModel>(), internal::InfoOf<OpenCVModel>(),
+        internal::InfoOf<EUCMModel>(), internal::InfoOf<EquirectangularModel>(),
+        internal::InfoOf<UnifiedOmniModel>(),
+        internal::InfoOf<DoubleSphereModel>()}) {
+    if (name == info.name) return info.id;
+  }
+  return -1;
+}
+
+// The functions below throw std::invalid_argument for an unknown id and (except
+// CheckParams, which reports it) for a wrong number of params.
+
+inline bool ImageFromRay(int model_id, const std::vector<double>& params,
+                         const Eigen::Vector3d& ray_in_cam,
+                         Eigen::Vector2d* pixel) {
+  return internal::VisitModel(model_id, [&](auto model) {
+    using Model = decltype(model);
+    internal::RequireParamCount<Model>(params);
+    return Model::ImageFromRay(params.data(), ray_in_cam.data(),
+                               pixel->data());
+  });
+}
+
+inline bool RayFromImage(int model_id, const std::vector<double>& params,
+                         const Eigen::Vector2d& pixel,
+                         Eigen::Vector3d* ray_in_cam) {
+  return internal::VisitModel(model_id, [&](auto model) {
+    using Model = decltype(model);
+    internal::RequireParamCount<Model>(params);
+    return Model::RayFromImage(params.data(), pixel.data(),
+                               ray_in_cam->data());
+  });
+}
+
+inline double PixelToAngle(int model_id, const std::vector<double>& params) {
+  return internal::VisitModel(model_id, [&](auto model) {
+    using Model = decltype(model);
+    internal::RequireParamCount<Model>(params);
+    return Model::PixelToAngle(params.data());
+  });
+}
+
+inline std::string CheckParams(int model_id, const std::vector<double>& params,
+                               int width, int height) {
+  return internal::VisitModel(model_id, [&](auto model) {
+    using Model = decltype(model);
+    return Model::CheckParams(params, width, height);
+  });
+}
+
+inline std::vector<double> InitialParams(int model_id, double focal_length,
+                                         int width, int height) {
+  return internal::VisitModel(model_id, [&](auto model) {
+    using Model = decltype(model);
+    return Model::InitialParams(focal_length, width, height);
+  });
+}
+
+}  // namespace sphera

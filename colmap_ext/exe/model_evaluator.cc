@@ -1,0 +1,451 @@
+#include "colmap_ext/exe/model_evaluator.h"
+
+#include "colmap/controllers/option_manager.h"
+#include "colmap/estimators/alignment.h"
+#include "colmap/geometry/pose.h"
+#include "colmap/math/math.h"
+#include "colmap/util/logging.h"
+#include "colmap/util/misc.h"
+
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <unordered_map>
+
+namespace colmap {
+namespace {
+
+// sphera_render's range map: int32 width, int32 height, then row-major
+// float32 ranges along the pixel-centre rays (little-endian); 0 = no hit.
+struct DepthMap {
+  int width = 0;
+  int height = 0;
+  std::vector<float> ranges;
+
+  bool Read(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) {
+      return false;
+    }
+    int32_t size[2];
+    file.read(reinterpret_cast<char*>(size), sizeof(size));
+    if (!file || size[0] <= 0 || size[1] <= 0 ||
+        static_cast<int64_t>(size[0]) * size[1] > (int64_t{1} << 31)) {
+      return false;
+    }
+    width = size[0];
+    height = size[1];
+    ranges.resize(static_cast<size_t>(width) * height);
+    file.read(reinterpret_cast<char*>(ranges.data()),
+              ranges.size() * sizeof(float));
+    return static_cast<bool>(file);
+  }
+
+  // Range at the pixel containing `point2D`; 0 outside or without a hit.
+  double At(const Eigen::Vector2d& point2D) const {
+    const int x = static_cast<int>(std::floor(point2D.x()));
+    const int y = static_cast<int>(std::floor(point2D.y()));
+    if (x < 0 || y < 0 || x >= width || y >= height) {
+      return 0;
+    }
+    return ranges[static_cast<size_t>(y) * width + x];
+  }
+};
+
+double ClosestPairBaseline(const Reconstruction& reconstruction) {
+  std::vector<Eigen::Vector3d> centers;
+  for (const image_t image_id : reconstruction.RegImageIds()) {
+    centers.push_back(reconstruction.Image(image_id).ProjectionCenter());
+  }
+  double closest = std::numeric_limits<double>::max();
+  double largest = 0;
+  for (size_t i = 0; i < centers.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      const double distance = (centers[i] - centers[j]).norm();
+      closest = std::min(closest, distance);
+      largest = std::max(largest, distance);
+    }
+  }
+  return centers.size() < 2 ? 0 : closest;
+}
+
+double LargestBaseline(const Reconstruction& reconstruction) {
+  double largest = 0;
+  const std::vector<image_t>& image_ids = reconstruction.RegImageIds();
+  for (size_t i = 0; i < image_ids.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      largest = std::max(
+          largest,
+          (reconstruction.Image(image_ids[i]).ProjectionCenter() -
+           reconstruction.Image(image_ids[j]).ProjectionCenter())
+              .norm());
+    }
+  }
+  return largest;
+}
+
+std::string JsonNumber(double value) {
+  if (!std::isfinite(value)) {
+    return "null";
+  }
+  std::ostringstream out;
+  out << std::setprecision(10) << value;
+  return out.str();
+}
+
+std::string JsonString(const std::string& value) {
+  std::string out = "\"";
+  for (const char c : value) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+// Writes next to `path` and renames, so a failed run never leaves a file
+// that looks complete.
+void WriteFileAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp_path = path + ".tmp";
+  {
+    std::ofstream file(tmp_path, std::ios::trunc);
+    THROW_CHECK_FILE_OPEN(file, tmp_path);
+    file << text;
+    if (!file) {
+      throw std::runtime_error("cannot write " + tmp_path);
+    }
+  }
+  if (std::rename(tmp_path.c_str(), path.c_str()) != 0) {
+    throw std::runtime_error("cannot rename " + tmp_path + " to " + path);
+  }
+}
+
+}  // namespace
+
+ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
+                              const Reconstruction& reconstruction,
+                              const ModelEvaluationOptions& options) {
+  ModelEvaluation evaluation;
+  evaluation.num_gt_images = ground_truth.NumRegImages();
+  evaluation.num_points3D = reconstruction.NumPoints3D();
+
+  const std::vector<std::pair<image_t, image_t>> common_image_ids =
+      reconstruction.FindCommonRegImageIds(ground_truth);
+  evaluation.num_registered = common_image_ids.size();
+  if (common_image_ids.size() < 3) {
+    throw std::invalid_argument(
+        StringPrintf("only %d registered images in common with the ground "
+                     "truth; at least 3 are needed to align",
+                     static_cast<int>(common_image_ids.size())));
+  }
+
+  double max_proj_center_error = options.max_proj_center_error;
+  if (max_proj_center_error <= 0) {
+    max_proj_center_error = 0.05 * LargestBaseline(ground_truth);
+  }
+  if (!(max_proj_center_error > 0)) {
+    throw std::invalid_argument(
+        "the ground-truth camera centres coincide; cannot align by centres");
+  }
+  Sim3d gt_from_reconstruction;
+  if (!AlignReconstructionsViaProjCenters(reconstruction,
+                                          ground_truth,
+                                          max_proj_center_error,
+                                          &gt_from_reconstruction)) {
+    throw std::invalid_argument(
+        "no similarity aligns the camera centres within " +
+        std::to_string(max_proj_center_error) + " (ground-truth units)");
+  }
+
+  evaluation.closest_pair_baseline = ClosestPairBaseline(ground_truth);
+  const std::vector<ImageAlignmentError> alignment_errors =
+      ComputeImageAlignmentError(
+          reconstruction, ground_truth, gt_from_reconstruction);
+  std::unordered_map<std::string, ImageAlignmentError> errors_by_name;
+  for (const ImageAlignmentError& error : alignment_errors) {
+    errors_by_name[error.image_name] = error;
+  }
+  for (const image_t image_id : ground_truth.RegImageIds()) {
+    ImageEvaluation image;
+    image.name = ground_truth.Image(image_id).Name();
+    const auto it = errors_by_name.find(image.name);
+    if (it != errors_by_name.end()) {
+      image.registered = true;
+      image.rotation_error_deg = it->second.rotation_error_deg;
+      image.position_error = it->second.proj_center_error;
+      image.position_error_normalized =
+          evaluation.closest_pair_baseline > 0
+              ? image.position_error / evaluation.closest_pair_baseline
+              : -1;
+      evaluation.mean_rotation_error_deg += image.rotation_error_deg;
+      evaluation.max_rotation_error_deg =
+          std::max(evaluation.max_rotation_error_deg, image.rotation_error_deg);
+      evaluation.mean_position_error += image.position_error;
+      evaluation.max_position_error =
+          std::max(evaluation.max_position_error, image.position_error);
+      evaluation.mean_position_error_normalized +=
+          image.position_error_normalized;
+    }
+    evaluation.images.push_back(image);
+  }
+  evaluation.mean_rotation_error_deg /= evaluation.num_registered;
+  evaluation.mean_position_error /= evaluation.num_registered;
+  evaluation.mean_position_error_normalized /= evaluation.num_registered;
+
+  // Angular reprojection error over all observations, per camera too.
+  std::map<camera_t, CameraEvaluation> cameras;
+  for (const auto& [point3D_id, point3D] : reconstruction.Points3D()) {
+    for (const TrackElement& element : point3D.track.Elements()) {
+      const Image& image = reconstruction.Image(element.image_id);
+      const Camera& camera = reconstruction.Camera(image.CameraId());
+      Eigen::Vector3d ray_in_cam;
+      if (!camera.CamRayFromImg(image.Point2D(element.point2D_idx).xy,
+                                &ray_in_cam)) {
+        continue;
+      }
+      const Eigen::Vector3d point_in_cam = image.CamFromWorld() * point3D.xyz;
+      const double angle = std::atan2(ray_in_cam.cross(point_in_cam).norm(),
+                                      ray_in_cam.dot(point_in_cam));
+      CameraEvaluation& camera_evaluation = cameras[camera.camera_id];
+      camera_evaluation.camera_id = camera.camera_id;
+      camera_evaluation.model_name = camera.ModelName();
+      camera_evaluation.num_observations += 1;
+      camera_evaluation.mean_angular_error_rad += angle;
+      camera_evaluation.mean_angular_error_px +=
+          angle / camera.CamRayFromImgThreshold(1.0);
+      evaluation.num_observations += 1;
+      evaluation.mean_angular_error_rad += angle;
+      evaluation.mean_angular_error_px +=
+          angle / camera.CamRayFromImgThreshold(1.0);
+    }
+  }
+  for (auto& [camera_id, camera_evaluation] : cameras) {
+    camera_evaluation.mean_angular_error_rad /=
+        camera_evaluation.num_observations;
+    camera_evaluation.mean_angular_error_px /=
+        camera_evaluation.num_observations;
+    evaluation.cameras.push_back(camera_evaluation);
+  }
+  if (evaluation.num_observations > 0) {
+    evaluation.mean_angular_error_rad /= evaluation.num_observations;
+    evaluation.mean_angular_error_px /= evaluation.num_observations;
+  }
+
+  // 3D point error against the ground-truth range maps: the true surface
+  // point on the observed ray of a ground-truth camera.
+  if (!options.depth_path.empty()) {
+    std::unordered_map<std::string, DepthMap> depth_maps;
+    std::unordered_map<std::string, image_t> gt_image_ids;
+    for (const image_t image_id : ground_truth.RegImageIds()) {
+      const std::string& name = ground_truth.Image(image_id).Name();
+      DepthMap depth_map;
+      const std::string depth_file =
+          JoinPaths(options.depth_path, name + ".depth.bin");
+      if (!depth_map.Read(depth_file)) {
+        throw std::invalid_argument("cannot read depth map " + depth_file);
+      }
+      depth_maps.emplace(name, std::move(depth_map));
+      gt_image_ids.emplace(name, image_id);
+    }
+    std::vector<double> point_errors;
+    for (const auto& [point3D_id, point3D] : reconstruction.Points3D()) {
+      const Eigen::Vector3d point_in_gt = gt_from_reconstruction * point3D.xyz;
+      for (const TrackElement& element : point3D.track.Elements()) {
+        const Image& image = reconstruction.Image(element.image_id);
+        const auto gt_it = gt_image_ids.find(image.Name());
+        if (gt_it == gt_image_ids.end()) {
+          continue;
+        }
+        const Image& gt_image = ground_truth.Image(gt_it->second);
+        const Camera& gt_camera = ground_truth.Camera(gt_image.CameraId());
+        const Eigen::Vector2d& xy = image.Point2D(element.point2D_idx).xy;
+        const double range = depth_maps.at(image.Name()).At(xy);
+        Eigen::Vector3d ray_in_cam;
+        if (range <= 0 || !gt_camera.CamRayFromImg(xy, &ray_in_cam)) {
+          continue;
+        }
+        const Rigid3d world_from_cam = Inverse(gt_image.CamFromWorld());
+        const Eigen::Vector3d surface_point =
+            world_from_cam * (range * ray_in_cam);
+        point_errors.push_back((point_in_gt - surface_point).norm());
+        break;
+      }
+    }
+    evaluation.num_points_with_depth = point_errors.size();
+    if (!point_errors.empty()) {
+      evaluation.mean_point_error = Mean(point_errors);
+      evaluation.median_point_error = Median(point_errors);
+    }
+  }
+  return evaluation;
+}
+
+std::string ModelEvaluationToJson(const ModelEvaluation& e) {
+  std::ostringstream json;
+  json << "{\n"
+       << "  \"num_gt_images\": " << e.num_gt_images << ",\n"
+       << "  \"num_registered\": " << e.num_registered << ",\n"
+       << "  \"num_points3D\": " << e.num_points3D << ",\n"
+       << "  \"closest_pair_baseline\": "
+       << JsonNumber(e.closest_pair_baseline) << ",\n"
+       << "  \"mean_rotation_error_deg\": "
+       << JsonNumber(e.mean_rotation_error_deg) << ",\n"
+       << "  \"max_rotation_error_deg\": "
+       << JsonNumber(e.max_rotation_error_deg) << ",\n"
+       << "  \"mean_position_error\": " << JsonNumber(e.mean_position_error)
+       << ",\n"
+       << "  \"max_position_error\": " << JsonNumber(e.max_position_error)
+       << ",\n"
+       << "  \"mean_position_error_normalized\": "
+       << JsonNumber(e.mean_position_error_normalized) << ",\n"
+       << "  \"num_observations\": " << e.num_observations << ",\n"
+       << "  \"mean_angular_error_rad\": "
+       << JsonNumber(e.mean_angular_error_rad) << ",\n"
+       << "  \"mean_angular_error_px\": " << JsonNumber(e.mean_angular_error_px)
+       << ",\n"
+       << "  \"num_points_with_depth\": " << e.num_points_with_depth << ",\n"
+       << "  \"mean_point_error\": " << JsonNumber(e.mean_point_error) << ",\n"
+       << "  \"median_point_error\": " << JsonNumber(e.median_point_error)
+       << ",\n"
+       << "  \"cameras\": [";
+  for (size_t i = 0; i < e.cameras.size(); ++i) {
+    const CameraEvaluation& c = e.cameras[i];
+    json << (i ? ",\n" : "\n") << "    {\"camera_id\": " << c.camera_id
+         << ", \"model\": " << JsonString(c.model_name)
+         << ", \"num_observations\": " << c.num_observations
+         << ", \"mean_angular_error_rad\": "
+         << JsonNumber(c.mean_angular_error_rad)
+         << ", \"mean_angular_error_px\": "
+         << JsonNumber(c.mean_angular_error_px) << "}";
+  }
+  json << "\n  ],\n  \"images\": [";
+  for (size_t i = 0; i < e.images.size(); ++i) {
+    const ImageEvaluation& image = e.images[i];
+    json << (i ? ",\n" : "\n") << "    {\"name\": " << JsonString(image.name)
+         << ", \"registered\": " << (image.registered ? "true" : "false")
+         << ", \"rotation_error_deg\": "
+         << JsonNumber(image.rotation_error_deg)
+         << ", \"position_error\": " << JsonNumber(image.position_error)
+         << ", \"position_error_normalized\": "
+         << JsonNumber(image.position_error_normalized) << "}";
+  }
+  json << "\n  ]\n}\n";
+  return json.str();
+}
+
+int RunModelEvaluator(int argc, char** argv) {
+  std::string gt_path;
+  std::string input_path;
+  std::string output_path;
+  ModelEvaluationOptions evaluation_options;
+
+  OptionManager options;
+  options.AddRequiredOption("gt_path", &gt_path);
+  options.AddRequiredOption("input_path", &input_path);
+  options.AddDefaultOption("output_path", &output_path);
+  options.AddDefaultOption("depth_path", &evaluation_options.depth_path);
+  options.AddDefaultOption("max_proj_center_error",
+                           &evaluation_options.max_proj_center_error);
+  options.Parse(argc, argv);
+
+  for (const auto& [name, path] :
+       {std::make_pair("gt_path", gt_path),
+        std::make_pair("input_path", input_path)}) {
+    if (!ExistsDir(path)) {
+      LOG(ERROR) << name << ": " << path << " is not a directory";
+      return EXIT_FAILURE;
+    }
+  }
+  if (!output_path.empty() && !ExistsDir(output_path)) {
+    LOG(ERROR) << "output_path: " << output_path << " is not a directory";
+    return EXIT_FAILURE;
+  }
+
+  ModelEvaluation evaluation;
+  try {
+    Reconstruction ground_truth;
+    try {
+      ground_truth.Read(gt_path);
+    } catch (const std::exception& error) {
+      throw std::invalid_argument("cannot read the ground truth " + gt_path +
+                                  ": " + error.what());
+    }
+    Reconstruction reconstruction;
+    try {
+      reconstruction.Read(input_path);
+    } catch (const std::exception& error) {
+      throw std::invalid_argument("cannot read the model " + input_path +
+                                  ": " + error.what());
+    }
+    evaluation = EvaluateModel(ground_truth, reconstruction, evaluation_options);
+  } catch (const std::exception& error) {
+    LOG(ERROR) << "model_evaluator: " << error.what();
+    return EXIT_FAILURE;
+  }
+
+  std::ostringstream table;
+  table << std::fixed;
+  table << "image                          reg   rot_err_deg  pos_err      "
+           "pos_err/baseline\n";
+  for (const ImageEvaluation& image : evaluation.images) {
+    table << std::left << std::setw(30) << image.name << " "
+          << (image.registered ? "yes" : "no ") << "   ";
+    if (image.registered) {
+      table << std::setprecision(5) << std::setw(12)
+            << image.rotation_error_deg << " " << std::setprecision(6)
+            << std::setw(12) << image.position_error << " "
+            << image.position_error_normalized;
+    }
+    table << "\n";
+  }
+  table << std::setprecision(6) << "registered: " << evaluation.num_registered
+        << "/" << evaluation.num_gt_images
+        << "\nrotation error (deg): mean " << evaluation.mean_rotation_error_deg
+        << " max " << evaluation.max_rotation_error_deg
+        << "\nposition error: mean " << evaluation.mean_position_error
+        << " max " << evaluation.max_position_error << " (mean "
+        << evaluation.mean_position_error_normalized
+        << " of the closest-pair baseline "
+        << evaluation.closest_pair_baseline << ")"
+        << "\nreprojection error: mean " << evaluation.mean_angular_error_rad
+        << " rad = " << evaluation.mean_angular_error_px << " px over "
+        << evaluation.num_observations << " observations\n";
+  for (const CameraEvaluation& camera : evaluation.cameras) {
+    table << "  camera " << camera.camera_id << " (" << camera.model_name
+          << "): " << camera.mean_angular_error_rad << " rad = "
+          << camera.mean_angular_error_px << " px\n";
+  }
+  if (evaluation.mean_point_error >= 0) {
+    table << "3D point error: mean " << evaluation.mean_point_error
+          << " median " << evaluation.median_point_error << " over "
+          << evaluation.num_points_with_depth << " points\n";
+  }
+  std::cout << table.str() << std::flush;
+
+  if (!output_path.empty()) {
+    std::ostringstream csv;
+    csv << std::setprecision(10)
+        << "name,registered,rotation_error_deg,position_error,"
+           "position_error_normalized\n";
+    for (const ImageEvaluation& image : evaluation.images) {
+      csv << image.name << "," << (image.registered ? 1 : 0) << ","
+          << image.rotation_error_deg << "," << image.position_error << ","
+          << image.position_error_normalized << "\n";
+    }
+    try {
+      WriteFileAtomically(JoinPaths(output_path, "evaluation.json"),
+                          ModelEvaluationToJson(evaluation));
+      WriteFileAtomically(JoinPaths(output_path, "evaluation_images.csv"),
+                          csv.str());
+    } catch (const std::exception& error) {
+      LOG(ERROR) << "model_evaluator: " << error.what();
+      return EXIT_FAILURE;
+    }
+  }
+  return EXIT_SUCCESS;
+}
+
+}  // namespace colmap

@@ -1,0 +1,242 @@
+// SPHERA estimators: the angular (log-map) residual on the unit sphere.
+//
+// Mathematics
+// -----------
+// A central camera observes a 3D point through a unit bearing ray u in S^2.
+// A model predicts a ray v = R X + t (camera frame, not necessarily unit).
+// The natural error is the geodesic angle between u and v/|v|.  To give a
+// least-squares solver a 2-vector whose squared norm is that angle squared, we
+// use the logarithm map of S^2 at u, expressed in a tangent basis (e1, e2) of
+// u (e1, e2, u orthonormal):
+//
+//   v^ = v / |v|,   c = u . v^,   w = v^ - c u   (tangent component),
+//   a = e1 . v^ = e1 . w,   b = e2 . v^ = e2 . w,   s = |w| = sqrt(a^2 + b^2),
+//   theta = atan2(s, c)                          (geodesic angle, in [0, pi]),
+//   r = theta * (a, b) / s  =  Log_u(v^) in the basis (e1, e2).
+//
+// Hence |r| = theta exactly.  Because atan2(s, c) and (a, b)/s are invariant
+// under a positive scaling of v, the normalisation of v is never performed:
+// a, b, c are computed from the raw v.  acos is never used (and never
+// differentiated), so the residual is accurate for tiny and large angles.
+//
+// Small-angle limit: with x = s / c (c > 0),
+//   theta / s = atan(x) / (x c) = (1/c) (1 - x^2/3 + x^4/5 - x^6/7 + ...),
+// which only involves x^2 = (a^2 + b^2) / c^2, i.e. no square root.  Using
+// this series for x^2 < 1e-4 keeps ceres::Jet derivatives finite at zero error
+// (sqrt has an infinite derivative at 0); the truncation error is
+// O(x^8) < 1e-16 relative.
+//
+// The residual is singular only at the antipode (v^ = -u, theta = pi) where
+// the direction of the log map is undefined; we return (pi, 0) there.
+//
+// Tangent basis: the branchless orthonormal basis of Duff et al., "Building an
+// Orthonormal Basis, Revisited" (JCGT 2017): with sigma = sign(u_z) and
+// k = -1 / (sigma + u_z),
+//   e1 = (1 + sigma k u_x^2, sigma k u_x u_y, -sigma u_x),
+//   e2 = (k u_x u_y, sigma + k u_y^2, -u_y),
+// which is deterministic, smooth away from the plane u_z = 0 (where sigma
+// flips), and satisfies e1 x e2 = u.  Requires |u| = 1.
+#pragma once
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+namespace sphera {
+
+// Tangent basis (e1, e2) of the unit vector u, see header comment.
+template <typename T>
+inline void RayTangentBasis(const T* u, T* e1, T* e2) {
+  const T sigma = (u[2] < T(0)) ? T(-1) : T(1);
+  const T k = T(-1) / (sigma + u[2]);
+  const T kxy = k * u[0] * u[1];
+  e1[0] = T(1) + sigma * k * u[0] * u[0];
+  e1[1] = sigma * kxy;
+  e1[2] = -sigma * u[0];
+  e2[0] = kxy;
+  e2[1] = sigma + k * u[1] * u[1];
+  e2[2] = -u[1];
+}
+
+inline void RayTangentBasis(const Eigen::Vector3d& u, Eigen::Vector3d* e1,
+                            Eigen::Vector3d* e2) {
+  RayTangentBasis(u.data(), e1->data(), e2->data());
+}
+
+// Log-map residual from the tangent/normal components of the predicted ray:
+// a = e1 . v, b = e2 . v, c = u . v (v need not be unit).  See header.
+template <typename T>
+inline void LogMapResidualFromComponents(const T& a, const T& b, const T& c,
+                                         T* residual) {
+  const T s2 = a * a + b * b;
+  if (c > T(0) && s2 < T(1e-4) * c * c) {
+    // theta / s = (1/c)(1 - x^2/3 + x^4/5 - x^6/7), x^2 = s^2 / c^2.
+    const T x2 = s2 / (c * c);
+    const T scale =
+        (T(1) - x2 * (T(1.0 / 3.0) - x2 * (T(1.0 / 5.0) - x2 * T(1.0 / 7.0)))) /
+        c;
+    residual[0] = scale * a;
+    residual[1] = scale * b;
+    return;
+  }
+  if (s2 == T(0)) {
+    // v^ = -u (antipode) or v = 0: direction undefined, angle = pi.
+    residual[0] = T(M_PI);
+    residual[1] = T(0);
+    return;
+  }
+  using std::atan2;
+  using std::sqrt;
+  const T s = sqrt(s2);
+  const T scale = atan2(s, c) / s;
+  residual[0] = scale * a;
+  residual[1] = scale * b;
+}
+
+// Log-map residual of the predicted ray v at the observed unit ray u, with the
+// tangent basis of u computed internally (templated, Jet-safe).
+template <typename T>
+inline void AngularLogResidual(const T* u, const T* v, T* residual) {
+  T e1[3], e2[3];
+  RayTangentBasis(u, e1, e2);
+  const T a = e1[0] * v[0] + e1[1] * v[1] + e1[2] * v[2];
+  const T b = e2[0] * v[0] + e2[1] * v[1] + e2[2] * v[2];
+  const T c = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+  LogMapResidualFromComponents(a, b, c, residual);
+}
+
+inline Eigen::Vector2d AngularLogResidual(const Eigen::Vector3d& u,
+                                          const Eigen::Vector3d& v) {
+  Eigen::Vector2d r;
+  AngularLogResidual(u.data(), v.data(), r.data());
+  return r;
+}
+
+// Geodesic angle between two (not necessarily unit) directions, in [0, pi]:
+// theta = atan2(|a x b|, a . b).  Accurate at 0 and pi (no acos).
+inline double AngleBetweenRays(const Eigen::Vector3d& a,
+                               const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+// Quaternion convention of the Ceres cost functors below: q = [w, x, y, z]
+// (ceres::QuaternionRotatePoint / ceres::QuaternionManifold).
+inline Eigen::Vector4d RotationMatrixToQuaternionWXYZ(const Eigen::Matrix3d& R) {
+  const Eigen::Quaterniond q(R);
+  return Eigen::Vector4d(q.w(), q.x(), q.y(), q.z());
+}
+
+inline Eigen::Matrix3d QuaternionWXYZToRotationMatrix(const Eigen::Vector4d& q) {
+  return Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized()
+      .toRotationMatrix();
+}
+
+// Ceres cost: angular reprojection error of a world point in a camera.
+//
+//   parameters: cam_from_world_rotation q = [w, x, y, z]     (4, use
+//               ceres::QuaternionManifold), cam_from_world_translation t (3),
+//               point3D X (3, world frame);
+//   residual:   r = Log_u(R(q) X + t) in the tangent basis of the observed
+//               unit ray u (2),  |r| = angle(u, R X + t)  [rad].
+//
+// A point behind the ray (angle > 90 deg) simply has a large residual.
+// kEigenOrder = true takes q in Eigen's coefficient order [x, y, z, w]
+// (Eigen::Quaterniond::coeffs(), as COLMAP 3.10's Rigid3d stores it; use
+// ceres::EigenQuaternionManifold); see AngularReprojectionCostEigenQuat.
+template <bool kEigenOrder>
+class AngularReprojectionCostT {
+ public:
+  explicit AngularReprojectionCostT(const Eigen::Vector3d& observed_ray)
+      : u_(observed_ray.normalized()) {
+    RayTangentBasis(u_, &e1_, &e2_);
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& observed_ray) {
+    return new ceres::AutoDiffCostFunction<AngularReprojectionCostT, 2, 4, 3,
+                                           3>(
+        new AngularReprojectionCostT(observed_ray));
+  }
+
+  template <typename T>
+  bool operator()(const T* const cam_from_world_rotation,
+                  const T* const cam_from_world_translation,
+                  const T* const point3D, T* residuals) const {
+    T v[3];
+    if (kEigenOrder) {
+      const T q_wxyz[4] = {cam_from_world_rotation[3],
+                           cam_from_world_rotation[0],
+                           cam_from_world_rotation[1],
+                           cam_from_world_rotation[2]};
+      ceres::QuaternionRotatePoint(q_wxyz, point3D, v);
+    } else {
+      ceres::QuaternionRotatePoint(cam_from_world_rotation, point3D, v);
+    }
+    v[0] += cam_from_world_translation[0];
+    v[1] += cam_from_world_translation[1];
+    v[2] += cam_from_world_translation[2];
+    const T a = T(e1_(0)) * v[0] + T(e1_(1)) * v[1] + T(e1_(2)) * v[2];
+    const T b = T(e2_(0)) * v[0] + T(e2_(1)) * v[1] + T(e2_(2)) * v[2];
+    const T c = T(u_(0)) * v[0] + T(u_(1)) * v[1] + T(u_(2)) * v[2];
+    LogMapResidualFromComponents(a, b, c, residuals);
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d u_, e1_, e2_;
+};
+
+// Quaternion [w, x, y, z] (ceres convention, ceres::QuaternionManifold).
+using AngularReprojectionCost = AngularReprojectionCostT<false>;
+// Quaternion [x, y, z, w] (Eigen / COLMAP 3.10, ceres::EigenQuaternionManifold).
+using AngularReprojectionCostEigenQuat = AngularReprojectionCostT<true>;
+
+// Same residual with a fixed camera (cam_from_world = [R | t]); only the
+// point X (3) is a parameter.  Used for triangulation refinement.
+class AngularReprojectionConstantPoseCost {
+ public:
+  AngularReprojectionConstantPoseCost(const Eigen::Vector3d& observed_ray,
+                                      const Eigen::Matrix3d& cam_from_world_R,
+                                      const Eigen::Vector3d& cam_from_world_t)
+      : u_(observed_ray.normalized()) {
+    Eigen::Vector3d e1, e2;
+    RayTangentBasis(u_, &e1, &e2);
+    // Rows: e1, e2, u applied to (R X + t) -> a, b, c are affine in X.
+    Eigen::Matrix3d B;
+    B.row(0) = e1.transpose();
+    B.row(1) = e2.transpose();
+    B.row(2) = u_.transpose();
+    A_ = B * cam_from_world_R;
+    b_ = B * cam_from_world_t;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& observed_ray,
+                                     const Eigen::Matrix3d& cam_from_world_R,
+                                     const Eigen::Vector3d& cam_from_world_t) {
+    return new ceres::AutoDiffCostFunction<AngularReprojectionConstantPoseCost,
+                                           2, 3>(
+        new AngularReprojectionConstantPoseCost(observed_ray, cam_from_world_R,
+                                                cam_from_world_t));
+  }
+
+  template <typename T>
+  bool operator()(const T* const point3D, T* residuals) const {
+    T abc[3];
+    for (int i = 0; i < 3; ++i) {
+      abc[i] = T(A_(i, 0)) * point3D[0] + T(A_(i, 1)) * point3D[1] +
+               T(A_(i, 2)) * point3D[2] + T(b_(i));
+    }
+    LogMapResidualFromComponents(abc[0], abc[1], abc[2], residuals);
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d u_;
+  Eigen::Matrix3d A_;
+  Eigen::Vector3d b_;
+};
+
+}  // namespace sphera

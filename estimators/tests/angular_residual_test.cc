@@ -1,0 +1,209 @@
+#include "estimators/angular_residual.h"
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "estimators/tests/test_utils.h"
+
+namespace sphera {
+namespace {
+
+std::vector<Eigen::Vector3d> TestRays(std::mt19937* rng) {
+  std::vector<Eigen::Vector3d> rays = {
+      Eigen::Vector3d::UnitX(),  -Eigen::Vector3d::UnitX(),
+      Eigen::Vector3d::UnitY(),  -Eigen::Vector3d::UnitY(),
+      Eigen::Vector3d::UnitZ(),  -Eigen::Vector3d::UnitZ(),
+      Eigen::Vector3d(1, 1, 0).normalized(),  // on the basis switch u_z = 0
+      Eigen::Vector3d(1, 2, -1e-12).normalized(),
+      Eigen::Vector3d(1, 2, 1e-12).normalized()};
+  for (int i = 0; i < 40; ++i) rays.push_back(test::RandomUnitVector(rng));
+  return rays;
+}
+
+TEST(AngularResidual, TangentBasisIsOrthonormalRightHanded) {
+  std::mt19937 rng(1);
+  for (const Eigen::Vector3d& u : TestRays(&rng)) {
+    Eigen::Vector3d e1, e2;
+    RayTangentBasis(u, &e1, &e2);
+    EXPECT_NEAR(e1.norm(), 1, 1e-14);
+    EXPECT_NEAR(e2.norm(), 1, 1e-14);
+    EXPECT_NEAR(e1.dot(e2), 0, 1e-14);
+    EXPECT_NEAR(e1.dot(u), 0, 1e-14);
+    EXPECT_NEAR(e2.dot(u), 0, 1e-14);
+    EXPECT_LT((e1.cross(e2) - u).norm(), 1e-14);
+  }
+}
+
+TEST(AngularResidual, SquaredNormEqualsSquaredGeodesicAngle) {
+  std::mt19937 rng(2);
+  std::vector<double> angles;
+  // 1e-8 rad .. 179 deg, log-spaced, plus both sides of the series threshold.
+  const double max_angle = 179.0 * M_PI / 180.0;
+  for (int i = 0; i <= 200; ++i) {
+    angles.push_back(1e-8 * std::pow(max_angle / 1e-8, i / 200.0));
+  }
+  for (double a : {0.00999, 0.01, 0.01001, 0.0099999, 0.0100001}) {
+    angles.push_back(a);
+  }
+  std::uniform_real_distribution<double> log_scale(-3, 3);
+  int num_checked = 0;
+  for (const Eigen::Vector3d& u : TestRays(&rng)) {
+    for (double theta : angles) {
+      const Eigen::Vector3d w = test::RandomTangent(u, &rng);
+      const double scale = std::pow(10.0, log_scale(rng));
+      const Eigen::Vector3d v =
+          scale * (std::cos(theta) * u + std::sin(theta) * w);
+      const Eigen::Vector2d r = AngularLogResidual(u, v);
+      ASSERT_TRUE(r.allFinite());
+      EXPECT_NEAR(r.squaredNorm(), theta * theta, 1e-12)
+          << "theta=" << theta << " u=" << u.transpose();
+      EXPECT_NEAR(r.norm(), theta, 1e-12) << "theta=" << theta;
+      // Direction of the log map = tangent direction of the error.
+      Eigen::Vector3d e1, e2;
+      RayTangentBasis(u, &e1, &e2);
+      const Eigen::Vector3d dir = r(0) * e1 + r(1) * e2;
+      EXPECT_LT((dir / r.norm() - w).norm(), 1e-6) << "theta=" << theta;
+      // Double helper agrees.
+      EXPECT_NEAR(AngleBetweenRays(u, v), theta, 1e-12);
+      ++num_checked;
+    }
+  }
+  EXPECT_GT(num_checked, 9000);
+}
+
+TEST(AngularResidual, AntipodeAndZeroAreFinite) {
+  const Eigen::Vector3d u(0, 0, 1);
+  const Eigen::Vector2d r_anti = AngularLogResidual(u, -u);
+  EXPECT_NEAR(r_anti.norm(), M_PI, 1e-15);
+  const Eigen::Vector2d r_zero_err = AngularLogResidual(u, 3.0 * u);
+  EXPECT_EQ(r_zero_err.norm(), 0.0);
+}
+
+// Central differences of AngularReprojectionCost w.r.t. all 10 parameters.
+void CheckJacobianAgainstCentralDifferences(const Eigen::Vector3d& observed,
+                                            const Eigen::Vector4d& q,
+                                            const Eigen::Vector3d& t,
+                                            const Eigen::Vector3d& X,
+                                            double tol) {
+  std::unique_ptr<ceres::CostFunction> cost(
+      AngularReprojectionCost::Create(observed));
+  std::vector<double> params[3] = {{q(0), q(1), q(2), q(3)},
+                                   {t(0), t(1), t(2)},
+                                   {X(0), X(1), X(2)}};
+  const double* p[3] = {params[0].data(), params[1].data(), params[2].data()};
+  double r[2];
+  double J0[8], J1[6], J2[6];
+  double* J[3] = {J0, J1, J2};
+  ASSERT_TRUE(cost->Evaluate(p, r, J));
+  const int sizes[3] = {4, 3, 3};
+  const double h = 1e-6;
+  for (int b = 0; b < 3; ++b) {
+    for (int k = 0; k < sizes[b]; ++k) {
+      std::vector<double> plus[3] = {params[0], params[1], params[2]};
+      std::vector<double> minus[3] = {params[0], params[1], params[2]};
+      plus[b][k] += h;
+      minus[b][k] -= h;
+      const double* pp[3] = {plus[0].data(), plus[1].data(), plus[2].data()};
+      const double* pm[3] = {minus[0].data(), minus[1].data(),
+                             minus[2].data()};
+      double rp[2], rm[2];
+      ASSERT_TRUE(cost->Evaluate(pp, rp, nullptr));
+      ASSERT_TRUE(cost->Evaluate(pm, rm, nullptr));
+      for (int i = 0; i < 2; ++i) {
+        const double numeric = (rp[i] - rm[i]) / (2 * h);
+        const double analytic = J[b][i * sizes[b] + k];
+        ASSERT_TRUE(std::isfinite(analytic));
+        EXPECT_NEAR(analytic, numeric, tol * std::max(1.0, std::abs(numeric)))
+            << "block " << b << " param " << k << " residual " << i;
+      }
+    }
+  }
+}
+
+TEST(AngularResidual, CeresJacobianMatchesCentralDifferences) {
+  std::mt19937 rng(3);
+  for (double err_angle : {1e-3, 2e-2, 0.3, 1.5, 2.5}) {
+    for (int trial = 0; trial < 10; ++trial) {
+      const Eigen::Matrix3d R = test::RandomRotation(&rng);
+      const Eigen::Vector4d q = RotationMatrixToQuaternionWXYZ(R);
+      const Eigen::Vector3d t = test::RandomUnitVector(&rng);
+      const Eigen::Vector3d X = 3.0 * test::RandomUnitVector(&rng);
+      const Eigen::Vector3d v = (R * X + t).normalized();
+      const Eigen::Vector3d observed = test::PerturbRay(v, err_angle, &rng);
+      CheckJacobianAgainstCentralDifferences(observed, q, t, X, 1e-6);
+    }
+  }
+}
+
+TEST(AngularResidual, JacobianFiniteAndCorrectAtZeroError) {
+  std::mt19937 rng(4);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Matrix3d R = test::RandomRotation(&rng);
+    const Eigen::Vector3d t = test::RandomUnitVector(&rng);
+    const Eigen::Vector3d X = 4.0 * test::RandomUnitVector(&rng);
+    const Eigen::Vector3d v = R * X + t;
+    const Eigen::Vector3d u = v.normalized();
+    std::unique_ptr<ceres::CostFunction> cost(
+        AngularReprojectionConstantPoseCost::Create(u, R, t));
+    const double* p[1] = {X.data()};
+    double r[2];
+    Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J;
+    double* Jp[1] = {J.data()};
+    ASSERT_TRUE(cost->Evaluate(p, r, Jp));
+    EXPECT_NEAR(r[0], 0, 1e-15);
+    EXPECT_NEAR(r[1], 0, 1e-15);
+    ASSERT_TRUE(J.allFinite());
+    // At zero error dr/dv = [e1; e2] / |v|, so dr/dX = [e1; e2] R / |v|.
+    Eigen::Vector3d e1, e2;
+    RayTangentBasis(u, &e1, &e2);
+    Eigen::Matrix<double, 2, 3> expected;
+    expected.row(0) = e1.transpose() * R / v.norm();
+    expected.row(1) = e2.transpose() * R / v.norm();
+    EXPECT_LT((J - expected).norm(), 1e-12);
+
+    // Same for the full pose cost at exactly zero error.
+    const Eigen::Vector4d q = RotationMatrixToQuaternionWXYZ(R);
+    std::unique_ptr<ceres::CostFunction> full(
+        AngularReprojectionCost::Create(u));
+    const double* pf[3] = {q.data(), t.data(), X.data()};
+    double J0[8], J1[6], J2[6];
+    double* Jf[3] = {J0, J1, J2};
+    ASSERT_TRUE(full->Evaluate(pf, r, Jf));
+    for (double x : J0) EXPECT_TRUE(std::isfinite(x));
+    for (int i = 0; i < 6; ++i) {
+      EXPECT_TRUE(std::isfinite(J1[i]));
+      EXPECT_NEAR(J2[i], expected(i / 3, i % 3), 1e-10);
+    }
+  }
+}
+
+TEST(AngularResidual, EigenQuaternionOrderVariantAgrees) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Quaterniond q(test::RandomRotation(&rng));
+    const Eigen::Vector4d q_wxyz(q.w(), q.x(), q.y(), q.z());
+    const Eigen::Vector4d q_xyzw = q.coeffs();
+    const Eigen::Vector3d t = test::RandomUnitVector(&rng);
+    const Eigen::Vector3d X = 3.0 * test::RandomUnitVector(&rng);
+    const Eigen::Vector3d u = test::PerturbRay(
+        (q.toRotationMatrix() * X + t).normalized(), 0.1, &rng);
+    std::unique_ptr<ceres::CostFunction> c1(AngularReprojectionCost::Create(u));
+    std::unique_ptr<ceres::CostFunction> c2(
+        AngularReprojectionCostEigenQuat::Create(u));
+    const double* p1[3] = {q_wxyz.data(), t.data(), X.data()};
+    const double* p2[3] = {q_xyzw.data(), t.data(), X.data()};
+    double r1[2], r2[2];
+    ASSERT_TRUE(c1->Evaluate(p1, r1, nullptr));
+    ASSERT_TRUE(c2->Evaluate(p2, r2, nullptr));
+    EXPECT_NEAR(r1[0], r2[0], 1e-14);
+    EXPECT_NEAR(r1[1], r2[1], 1e-14);
+    EXPECT_NEAR(std::hypot(r1[0], r1[1]),
+                AngleBetweenRays(u, q.toRotationMatrix() * X + t), 1e-14);
+  }
+}
+
+}  // namespace
+}  // namespace sphera

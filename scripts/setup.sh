@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Installs the Debian packages SPHERA builds and runs with (Debian bookworm,
+# as root or with sudo). Installs only what is missing, so it is cheap to
+# call before every build.
+set -euo pipefail
+
+readonly PACKAGES=(
+  # toolchain
+  build-essential cmake ninja-build ccache git patch ca-certificates
+  dpkg-dev xz-utils
+  # COLMAP 3.10
+  libeigen3-dev libgoogle-glog-dev libgflags-dev libceres-dev libflann-dev
+  libfreeimage-dev libmetis-dev libsqlite3-dev libboost-program-options-dev
+  libboost-filesystem-dev libboost-graph-dev libboost-system-dev
+  libsuitesparse-dev libgtest-dev
+  # SPHERA: bearing-vector solvers, image remapping
+  libopengv-dev libopencv-dev
+  # tests, benchmarks and plots
+  python3 python3-numpy python3-matplotlib sqlite3
+)
+
+missing=()
+for package in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "${package}" 2>/dev/null \
+      | grep -q "install ok installed"; then
+    missing+=("${package}")
+  fi
+done
+
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "setup: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  SUDO="sudo"
+fi
+echo "setup: installing ${missing[*]}"
+${SUDO} apt-get update -qq
+DEBIAN_FRONTEND=noninteractive ${SUDO} apt-get install -y -qq --no-install-recommends \
+  "${missing[@]}" >/dev/null
+echo "setup: done"

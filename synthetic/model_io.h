@@ -1,0 +1,103 @@
+// Camera layouts, rig files and the ground-truth dataset written to disk in
+// COLMAP's text format.
+//
+// Dataset layout (DIR is written as DIR.tmp, then renamed):
+//   DIR/images/NAME                    rendered 8-bit JPEG (quality 95) or PNG
+//   DIR/depth/NAME.depth.bin           range map, see WriteDepthMap (render.h)
+//   DIR/sparse_gt/cameras.txt          CAMERA_ID MODEL WIDTH HEIGHT PARAMS[] (model names)
+//   DIR/sparse_gt/images.txt           IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME, then
+//                                      POINTS2D[] as (X, Y, POINT3D_ID) (empty without points)
+//   DIR/sparse_gt/points3D.txt         POINT3D_ID X Y Z R G B ERROR TRACK[] (IMAGE_ID, POINT2D_IDX)
+//   DIR/rig.txt                        the cameras in rig-file format (reproducible input)
+// Poses are cam_from_world (COLMAP). Pixels: upper-left image corner is (0, 0).
+//
+// Rig file: one camera per line, '#' starts a comment:
+//   NAME MODEL WIDTH HEIGHT PARAMS... | QW QX QY QZ TX TY TZ
+#ifndef SPHERA_SYNTHETIC_MODEL_IO_H_
+#define SPHERA_SYNTHETIC_MODEL_IO_H_
+
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "synthetic/render.h"
+#include "synthetic/scene.h"
+
+namespace sphera {
+namespace synthetic {
+
+// Default parameters for a model at a given image size: focal lengths so
+// that a perspective camera sees 90 degrees horizontally and a fisheye model
+// maps 95 degrees off-axis (a 190 degree field) to 0.48 * min(width, height)
+// from the image centre. Empty `error` on success.
+std::vector<double> DefaultParams(const std::string& model_name, int width, int height,
+                                  std::string* error);
+
+// Parses "1,2,3" (commas and/or blanks). False on a malformed number.
+bool ParseParamList(const std::string& text, std::vector<double>* values);
+
+struct LayoutOptions {
+  // room9: the paper's 9 cameras on a 3 x 3 grid (1 m spacing, 1.5 m above
+  //        the floor, small random rotations).
+  // ring:  N cameras on a 0.6 m circle looking outwards at the walls, with
+  //        alternating small height offsets (for perspective/stock COLMAP).
+  // grid:  N cameras on a square-ish grid over [-1.2, 1.2]^2, random heading.
+  std::string layout = "room9";
+  int num_cameras = 0;  // 0: the layout's default (room9: 9, ring: 16, grid: 9)
+  std::string model_name;  // empty: the layout's default model
+  int width = 0;           // 0: the layout's default size
+  int height = 0;
+  std::vector<double> params;  // empty: DefaultParams
+  uint64_t seed = 0;
+  std::string image_extension = ".jpg";
+};
+
+// Empty string on success, else a message.
+std::string MakeLayout(const LayoutOptions& options, std::vector<VirtualCamera>* cameras);
+
+// Reads a rig file. Names without .jpg/.jpeg/.png get `default_extension`.
+// Empty string on success, else a message naming the line and camera.
+std::string ReadRigFile(const std::string& path, const std::string& default_extension,
+                        std::vector<VirtualCamera>* cameras);
+
+// Checks every camera (model, parameters, size, pose), unique names and that
+// every centre lies in the free space of the scene.
+std::string CheckCameras(const Scene& scene, const std::vector<VirtualCamera>& cameras);
+
+struct PointObservation {
+  int image_index = 0;  // index into the camera list
+  Eigen::Vector2d pixel;
+};
+
+struct GroundTruthPoint {
+  Eigen::Vector3d xyz;
+  Eigen::Vector3i rgb;
+  std::vector<PointObservation> observations;
+};
+
+// Up to `num_points` random surface points seen unoccluded by at least two
+// cameras, with their exact projections.
+std::vector<GroundTruthPoint> SamplePoints(const Scene& scene,
+                                           const std::vector<VirtualCamera>& cameras,
+                                           int num_points, uint64_t seed);
+
+struct DatasetOptions {
+  RenderOptions render;
+  int num_points = 0;
+  uint64_t points_seed = 0;
+};
+
+// Renders every camera and writes the dataset into `output_dir` atomically
+// (via output_dir + ".tmp"). Refuses an existing non-empty `output_dir`.
+// Progress goes to `log` if not null. Empty string on success.
+std::string WriteDataset(const std::string& output_dir, const Scene& scene,
+                         const std::vector<VirtualCamera>& cameras,
+                         const DatasetOptions& options, std::ostream* log);
+
+}  // namespace synthetic
+}  // namespace sphera
+
+#endif  // SPHERA_SYNTHETIC_MODEL_IO_H_

@@ -1,0 +1,207 @@
+#include "synthetic/render.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "camera_models/registry.h"
+
+namespace sphera {
+namespace synthetic {
+
+Eigen::Vector3d VirtualCamera::CentreInWorld() const {
+  return -(cam_from_world_rotation.conjugate() * cam_from_world_translation);
+}
+
+std::string VirtualCamera::Check() const {
+  std::ostringstream error;
+  error << "camera '" << name << "': ";
+  if (name.empty() || name.find_first_of(" \t\n/\\") != std::string::npos) {
+    error << "image name must be non-empty and contain no blanks or slashes";
+    return error.str();
+  }
+  const int id = ModelIdFromName(model_name);
+  if (id < 0) {
+    error << "unknown camera model '" << model_name << "'";
+    return error.str();
+  }
+  if (model_id != id) {
+    error << "model id " << model_id << " does not match model " << model_name;
+    return error.str();
+  }
+  if (width <= 0 || height <= 0 || width > 65536 || height > 65536) {
+    error << "bad image size " << width << " x " << height;
+    return error.str();
+  }
+  for (size_t i = 0; i < params.size(); ++i) {
+    if (!std::isfinite(params[i])) {
+      error << "parameter " << i << " is not finite";
+      return error.str();
+    }
+  }
+  const std::string model_error = CheckParams(model_id, params, width, height);
+  if (!model_error.empty()) {
+    error << model_error;
+    return error.str();
+  }
+  const Eigen::Vector4d q = cam_from_world_rotation.coeffs();
+  if (!q.allFinite() || std::abs(q.norm() - 1) > 1e-6 ||
+      !cam_from_world_translation.allFinite()) {
+    error << "pose must have a unit quaternion and a finite translation";
+    return error.str();
+  }
+  return "";
+}
+
+VirtualCamera MakeCamera(const std::string& name, const std::string& model_name, int width,
+                         int height, const std::vector<double>& params,
+                         const Eigen::Matrix3d& world_from_cam_rotation,
+                         const Eigen::Vector3d& centre_in_world) {
+  VirtualCamera camera;
+  camera.name = name;
+  camera.model_name = model_name;
+  camera.model_id = ModelIdFromName(model_name);
+  camera.width = width;
+  camera.height = height;
+  camera.params = params;
+  camera.cam_from_world_rotation = Eigen::Quaterniond(world_from_cam_rotation.transpose());
+  camera.cam_from_world_rotation.normalize();
+  camera.cam_from_world_translation = -(camera.cam_from_world_rotation * centre_in_world);
+  return camera;
+}
+
+std::string RenderOptions::Check() const {
+  std::ostringstream error;
+  if (supersample < 1 || supersample > 16) {
+    error << "supersample must be in [1, 16] (got " << supersample << ")";
+  } else if (!(noise_sigma >= 0) || !std::isfinite(noise_sigma)) {
+    error << "noise_sigma must be >= 0 (got " << noise_sigma << ")";
+  } else if (num_threads < 0) {
+    error << "num_threads must be >= 0 (got " << num_threads << ")";
+  }
+  return error.str();
+}
+
+RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
+                     const RenderOptions& options) {
+  const int width = camera.width, height = camera.height;
+  RenderedImage out;
+  out.image.create(height, width, CV_8UC3);
+  out.depth.create(height, width, CV_32F);
+
+  const Eigen::Matrix3d world_from_cam = camera.cam_from_world_rotation.conjugate().toRotationMatrix();
+  const Eigen::Vector3d centre = camera.CentreInWorld();
+  const int k = options.supersample;
+  const double inv_samples = 1.0 / (k * k);
+
+  // Colour of the scene along the ray through `pixel`; false outside the
+  // model's domain. Range of the hit in `range` (0 if nothing is hit).
+  auto trace = [&](const Eigen::Vector2d& pixel, Eigen::Vector3f* colour, double* range) {
+    Eigen::Vector3d ray_in_cam;
+    if (!RayFromImage(camera.model_id, camera.params, pixel, &ray_in_cam)) return false;
+    const Eigen::Vector3d ray_in_world = (world_from_cam * ray_in_cam).normalized();
+    RayHit hit;
+    if (scene.CastRay(centre, ray_in_world, &hit)) {
+      *colour = scene.Colour(hit.face_id, hit.point);
+      *range = hit.range;
+    } else {
+      colour->setZero();
+      *range = 0;
+    }
+    return true;
+  };
+
+  auto render_row = [&](int row) {
+    std::mt19937_64 rng(options.noise_seed * 0x9e3779b97f4a7c15ULL + static_cast<uint64_t>(row));
+    std::normal_distribution<double> noise(0.0, 1.0);
+    cv::Vec3b* image_row = out.image.ptr<cv::Vec3b>(row);
+    float* depth_row = out.depth.ptr<float>(row);
+    for (int col = 0; col < width; ++col) {
+      // Pixel (col, row) covers [col, col+1] x [row, row+1]; its centre is
+      // (col + 0.5, row + 0.5) (COLMAP convention). Sub-pixel samples are
+      // stratified (one per cell of a K x K grid) and N-rooks (all K^2 x and
+      // all K^2 y offsets distinct): a near-axis-aligned edge is resolved to
+      // 1/K^2 px instead of 1/K px. Their mean is exactly the pixel centre,
+      // and for odd K the middle sample is the centre itself.
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      double centre_range = 0;
+      bool centre_done = false;
+      for (int sy = 0; sy < k; ++sy) {
+        for (int sx = 0; sx < k; ++sx) {
+          const Eigen::Vector2d pixel(col + (sx + (sy + 0.5) / k) / k,
+                                      row + (sy + (sx + 0.5) / k) / k);
+          // With odd K the middle sample is the pixel centre: reuse it for depth.
+          const bool is_centre = (k % 2 == 1) && sx == k / 2 && sy == k / 2;
+          Eigen::Vector3f colour;
+          double range = 0;
+          if (trace(pixel, &colour, &range)) {
+            sum += colour;
+            if (is_centre) centre_range = range;
+          }
+          centre_done = centre_done || is_centre;
+        }
+      }
+      if (!centre_done) {
+        Eigen::Vector3f colour;
+        if (!trace(Eigen::Vector2d(col + 0.5, row + 0.5), &colour, &centre_range)) centre_range = 0;
+      }
+      depth_row[col] = static_cast<float>(centre_range);
+      for (int c = 0; c < 3; ++c) {
+        double value = 255.0 * sum[c] * inv_samples;
+        if (options.noise_sigma > 0) value += options.noise_sigma * noise(rng);
+        // OpenCV stores BGR.
+        image_row[col][2 - c] = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+      }
+    }
+  };
+
+  int num_threads = options.num_threads > 0
+                        ? options.num_threads
+                        : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  num_threads = std::min(num_threads, height);
+  std::atomic<int> next_row(0);
+  auto worker = [&]() {
+    for (int row = next_row++; row < height; row = next_row++) render_row(row);
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < num_threads; ++t) threads.emplace_back(worker);
+  worker();
+  for (std::thread& thread : threads) thread.join();
+  return out;
+}
+
+bool WriteDepthMap(const std::string& path, const cv::Mat& depth) {
+  if (depth.type() != CV_32F) return false;
+  std::ofstream file(path, std::ios::binary);
+  if (!file) return false;
+  const int32_t size[2] = {depth.cols, depth.rows};
+  file.write(reinterpret_cast<const char*>(size), sizeof(size));
+  for (int row = 0; row < depth.rows; ++row) {
+    file.write(reinterpret_cast<const char*>(depth.ptr<float>(row)),
+               static_cast<std::streamsize>(sizeof(float)) * depth.cols);
+  }
+  return static_cast<bool>(file);
+}
+
+bool ReadDepthMap(const std::string& path, cv::Mat* depth) {
+  std::ifstream file(path, std::ios::binary);
+  int32_t size[2];
+  if (!file.read(reinterpret_cast<char*>(size), sizeof(size))) return false;
+  if (size[0] <= 0 || size[1] <= 0 || size[0] > 65536 || size[1] > 65536) return false;
+  depth->create(size[1], size[0], CV_32F);
+  for (int row = 0; row < size[1]; ++row) {
+    if (!file.read(reinterpret_cast<char*>(depth->ptr<float>(row)),
+                   static_cast<std::streamsize>(sizeof(float)) * size[0])) {
+      return false;
+    }
+  }
+  return file.peek() == std::ifstream::traits_type::eof();
+}
+
+}  // namespace synthetic
+}  // namespace sphera

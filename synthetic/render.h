@@ -1,0 +1,74 @@
+// Rendering the synthetic room through any SPHERA camera model: every pixel
+// is lifted to rays with sphera::RayFromImage (the same function the
+// reconstruction uses), so the images are exact for the model by construction.
+#ifndef SPHERA_SYNTHETIC_RENDER_H_
+#define SPHERA_SYNTHETIC_RENDER_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "synthetic/scene.h"
+
+namespace sphera {
+namespace synthetic {
+
+// One image to render: a camera model with its parameters and a pose.
+struct VirtualCamera {
+  std::string name;        // image file name, e.g. "cam000.jpg"
+  std::string model_name;  // e.g. "EQUIRECTANGULAR"
+  int model_id = -1;
+  int width = 0;
+  int height = 0;
+  std::vector<double> params;
+  // COLMAP convention: x_cam = cam_from_world_rotation * x_world + cam_from_world_translation.
+  Eigen::Quaterniond cam_from_world_rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d CentreInWorld() const;
+  // Empty string if valid, else a message naming the camera and the problem
+  // (unknown model, wrong parameter count or values, bad size).
+  std::string Check() const;
+};
+
+// Builds a camera from a pose given as centre and world_from_cam rotation.
+VirtualCamera MakeCamera(const std::string& name, const std::string& model_name, int width,
+                         int height, const std::vector<double>& params,
+                         const Eigen::Matrix3d& world_from_cam_rotation,
+                         const Eigen::Vector3d& centre_in_world);
+
+struct RenderOptions {
+  // K x K stratified (N-rooks) sub-pixel rays per pixel, averaged (box filter).
+  int supersample = 3;
+  // Standard deviation of additive Gaussian noise in 8-bit intensity levels.
+  double noise_sigma = 0;
+  uint64_t noise_seed = 0;
+  // 0: all hardware threads.
+  int num_threads = 0;
+
+  std::string Check() const;
+};
+
+struct RenderedImage {
+  cv::Mat image;  // CV_8UC3, BGR (OpenCV order), black outside the model's domain
+  cv::Mat depth;  // CV_32F, range along the pixel-centre ray in metres, 0 if no hit
+};
+
+// Renders `camera` (which must pass Check()). Deterministic given the scene,
+// the camera and the options (including the noise seed).
+RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
+                     const RenderOptions& options);
+
+// Depth file: int32 width, int32 height, then width*height float32 ranges in
+// metres, row-major (row 0 first), all little-endian; 0 where nothing is hit.
+bool WriteDepthMap(const std::string& path, const cv::Mat& depth);
+bool ReadDepthMap(const std::string& path, cv::Mat* depth);
+
+}  // namespace synthetic
+}  // namespace sphera
+
+#endif  // SPHERA_SYNTHETIC_RENDER_H_

@@ -1,0 +1,104 @@
+"""Helpers for the integration tests that drive the built `colmap` program."""
+import os
+import random
+import shutil
+import sqlite3
+import struct
+import subprocess
+import sys
+import tempfile
+import unittest
+
+COLMAP = os.environ.get("SPHERA_COLMAP", "")
+SHARED_DATA = os.environ.get(
+    "SPHERA_SHARED_DATA",
+    os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data"))
+
+# ctest reports a test that exits with this code as skipped.
+SKIP_EXIT_CODE = 77
+
+
+def run_colmap(*args, check=True, timeout=1800):
+    """Runs `colmap ARGS`, returns the CompletedProcess (stdout+stderr text)."""
+    if not COLMAP or not os.path.exists(COLMAP):
+        raise RuntimeError(f"SPHERA_COLMAP={COLMAP!r} is not the built colmap")
+    result = subprocess.run([COLMAP, *map(str, args)], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True,
+                            timeout=timeout)
+    if check and result.returncode != 0:
+        raise AssertionError(f"colmap {' '.join(map(str, args))} exited "
+                             f"{result.returncode}:\n{result.stdout[-4000:]}")
+    return result
+
+
+def write_noise_image(path, width, height, seed, gray=True):
+    """Writes a binary PGM with multi-scale blob texture that SIFT can match."""
+    rng = random.Random(seed)
+    pixels = bytearray(width * height)
+    # Value noise on a few scales, summed; nearest-cell lookups are enough to
+    # give SIFT corners and blobs.
+    layers = []
+    for cell in (64, 24, 9):
+        cols, rows = width // cell + 2, height // cell + 2
+        layers.append((cell, cols, [rng.random() for _ in range(cols * rows)]))
+    for y in range(height):
+        for x in range(width):
+            value = 0.0
+            for cell, cols, grid in layers:
+                value += grid[(y // cell) * cols + x // cell]
+            pixels[y * width + x] = min(255, int(value / len(layers) * 255))
+    with open(path, "wb") as f:
+        f.write(f"P5\n{width} {height}\n255\n".encode())
+        f.write(bytes(pixels))
+
+
+class Database:
+    """Read-only view of a COLMAP database."""
+
+    def __init__(self, path):
+        self.connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+
+    def close(self):
+        self.connection.close()
+
+    def scalar(self, sql, *args):
+        return self.connection.execute(sql, args).fetchone()[0]
+
+    def cameras(self):
+        rows = self.connection.execute(
+            "SELECT camera_id, model, width, height, params FROM cameras")
+        cameras = {}
+        for camera_id, model, width, height, params in rows:
+            values = struct.unpack(f"{len(params) // 8}d", params)
+            cameras[camera_id] = (model, width, height, list(values))
+        return cameras
+
+    def images(self):
+        return dict(self.connection.execute(
+            "SELECT name, camera_id FROM images").fetchall())
+
+    def num_keypoints(self):
+        return dict(self.connection.execute(
+            "SELECT images.name, keypoints.rows FROM keypoints "
+            "JOIN images ON images.image_id = keypoints.image_id").fetchall())
+
+
+class TempDirTestCase(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="sphera_test_")
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def path(self, *parts):
+        return os.path.join(self.tmp, *parts)
+
+
+def main_with_skip(required_paths):
+    """unittest.main(), but exits SKIP_EXIT_CODE when a data path is missing."""
+    missing = [p for p in required_paths if not os.path.exists(p)]
+    if missing:
+        print(f"SKIP: needs {', '.join(missing)} (the shared data set beside "
+              "the repository); not available here")
+        sys.exit(SKIP_EXIT_CODE)
+    unittest.main()

@@ -1,0 +1,45 @@
+"""Feature extraction and exhaustive matching on the 11 real Ricoh Theta S
+panoramas of the shared data set (../shared/data/equirect_flat/images, not in
+the repository: the test is skipped without it)."""
+import os
+import unittest
+
+from cli_util import (SHARED_DATA, Database, TempDirTestCase, main_with_skip,
+                      run_colmap)
+
+IMAGES = os.path.join(SHARED_DATA, "equirect_flat", "images")
+
+
+class EquirectFlatTest(TempDirTestCase):
+    def test_extract_and_match_with_equirectangular_model(self):
+        database_path = self.path("database.db")
+        run_colmap("feature_extractor", "--database_path", database_path,
+                   "--image_path", IMAGES,
+                   "--ImageReader.camera_model", "EQUIRECTANGULAR",
+                   "--SiftExtraction.use_gpu", "0")
+        database = Database(database_path)
+        images = database.images()
+        self.assertEqual(len(images), 11)
+        cameras = database.cameras()
+        for camera_id in set(images.values()):
+            self.assertEqual(cameras[camera_id],
+                             (17, 5376, 2688, [5376.0, 2688.0]))
+        keypoints = database.num_keypoints()
+        self.assertEqual(len(keypoints), 11)
+        for name, count in keypoints.items():
+            self.assertGreater(count, 2000, name)
+        database.close()
+
+        run_colmap("exhaustive_matcher", "--database_path", database_path,
+                   "--SiftMatching.use_gpu", "0")
+        database = Database(database_path)
+        num_pairs = database.scalar("SELECT COUNT(*) FROM matches")
+        self.assertEqual(num_pairs, 55)
+        num_matched = database.scalar(
+            "SELECT COUNT(*) FROM matches WHERE rows > 100")
+        self.assertGreater(num_matched, 10)
+        database.close()
+
+
+if __name__ == "__main__":
+    main_with_skip([IMAGES])

@@ -1,0 +1,221 @@
+"""`colmap model_evaluator` and `colmap strecha_importer`: exact errors for
+known perturbations, clear failures for bad input."""
+import json
+import math
+import os
+import random
+
+from cli_util import SHARED_DATA, TempDirTestCase, run_colmap
+
+import unittest
+
+
+def quat_mul(a, b):
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw)
+
+
+def quat_rotate(q, v):
+    w, x, y, z = quat_mul(quat_mul(q, (0.0, *v)), (q[0], -q[1], -q[2], -q[3]))
+    return (x, y, z)
+
+
+def axis_angle_quat(axis, angle):
+    norm = math.sqrt(sum(a * a for a in axis))
+    s = math.sin(angle / 2) / norm
+    return (math.cos(angle / 2), axis[0] * s, axis[1] * s, axis[2] * s)
+
+
+class Pose:
+    """cam_from_world as a unit quaternion (w, x, y, z) and a translation."""
+
+    def __init__(self, q, t):
+        self.q, self.t = q, t
+
+    def center(self):
+        q_inv = (self.q[0], -self.q[1], -self.q[2], -self.q[3])
+        return tuple(-c for c in quat_rotate(q_inv, self.t))
+
+    @staticmethod
+    def from_center(q, center):
+        return Pose(q, tuple(-c for c in quat_rotate(q, center)))
+
+
+def write_model(path, poses, model_line="EQUIRECTANGULAR 2048 1024 2048 1024"):
+    os.makedirs(path)
+    with open(os.path.join(path, "cameras.txt"), "w") as f:
+        f.write(f"1 {model_line}\n")
+    with open(os.path.join(path, "images.txt"), "w") as f:
+        for i, pose in enumerate(poses):
+            f.write(f"{i + 1} {' '.join(map(repr, pose.q))} "
+                    f"{' '.join(map(repr, pose.t))} 1 view{i}.jpg\n\n")
+    open(os.path.join(path, "points3D.txt"), "w").close()
+
+
+def ground_truth_poses(count=9, seed=3):
+    rng = random.Random(seed)
+    poses = []
+    for i in range(count):
+        q = axis_angle_quat((rng.uniform(-1, 1), rng.uniform(-1, 1), 1),
+                            rng.uniform(-0.5, 0.5))
+        # A planar 3 x 3 grid: camera 4 sits exactly at the centroid.
+        center = (float(i % 3) - 1, 0.0, float(i // 3) - 1)
+        poses.append(Pose.from_center(q, center))
+    return poses
+
+
+class ModelEvaluatorTest(TempDirTestCase):
+    def evaluate(self, gt, estimate, check=True):
+        os.makedirs(self.path("out"), exist_ok=True)
+        return run_colmap("model_evaluator", "--gt_path", gt, "--input_path",
+                          estimate, "--output_path", self.path("out"),
+                          check=check)
+
+    def read_json(self):
+        with open(self.path("out", "evaluation.json")) as f:
+            return json.load(f)
+
+    def test_ground_truth_against_itself_has_zero_error(self):
+        write_model(self.path("gt"), ground_truth_poses())
+        self.evaluate(self.path("gt"), self.path("gt"))
+        result = self.read_json()
+        self.assertEqual(result["num_registered"], 9)
+        self.assertEqual(result["num_gt_images"], 9)
+        self.assertLess(result["max_rotation_error_deg"], 1e-6)
+        self.assertLess(result["max_position_error"], 1e-9)
+        self.assertAlmostEqual(result["closest_pair_baseline"], 1.0, delta=0.25)
+
+    def test_known_similarity_and_perturbations_are_measured(self):
+        gt = ground_truth_poses()
+        write_model(self.path("gt"), gt)
+        # A similarity world change (scale 2.5, rotation, translation), then a
+        # known rotation of one camera and a known centre offset of another.
+        scale = 2.5
+        q_sim = axis_angle_quat((0.3, -1, 0.2), 0.8)
+        t_sim = (4.0, -2.0, 1.5)
+        rotation_error_deg = 0.5
+        offset = 0.02  # ground-truth units
+        estimate = []
+        for i, pose in enumerate(gt):
+            center = pose.center()
+            if i == 4:
+                center = (center[0] + offset, center[1], center[2])
+            new_center = tuple(scale * c + t for c, t in
+                               zip(quat_rotate(q_sim, center), t_sim))
+            q_world = quat_mul(pose.q, (q_sim[0], -q_sim[1], -q_sim[2],
+                                        -q_sim[3]))
+            if i == 7:
+                q_world = quat_mul(axis_angle_quat(
+                    (0, 1, 0), math.radians(rotation_error_deg)), q_world)
+            estimate.append(Pose.from_center(q_world, new_center))
+        write_model(self.path("estimate"), estimate)
+        self.evaluate(self.path("gt"), self.path("estimate"))
+        result = self.read_json()
+        self.assertEqual(result["num_registered"], 9)
+        by_name = {image["name"]: image for image in result["images"]}
+        self.assertAlmostEqual(by_name["view7.jpg"]["rotation_error_deg"],
+                               rotation_error_deg, delta=1e-6)
+        for name, image in by_name.items():
+            if name != "view7.jpg":
+                self.assertLess(image["rotation_error_deg"], 1e-6, name)
+        # The least-squares similarity spreads the offset of the camera at the
+        # centroid over all nine (its rotation and, to first order, its scale
+        # are unaffected): that camera keeps 8/9 of it, every other 1/9.
+        self.assertAlmostEqual(by_name["view4.jpg"]["position_error"],
+                               offset * 8 / 9, delta=2e-4)
+        self.assertAlmostEqual(by_name["view0.jpg"]["position_error"],
+                               offset / 9, delta=2e-4)
+
+    def test_unregistered_images_are_counted(self):
+        gt = ground_truth_poses()
+        write_model(self.path("gt"), gt)
+        write_model(self.path("estimate"), gt[:5])
+        self.evaluate(self.path("gt"), self.path("estimate"))
+        result = self.read_json()
+        self.assertEqual((result["num_registered"], result["num_gt_images"]),
+                         (5, 9))
+        self.assertEqual(sum(not image["registered"]
+                             for image in result["images"]), 4)
+
+    def test_fewer_than_three_common_images_fail_cleanly(self):
+        gt = ground_truth_poses()
+        write_model(self.path("gt"), gt)
+        write_model(self.path("estimate"), gt[:2])
+        result = self.evaluate(self.path("gt"), self.path("estimate"),
+                               check=False)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("at least 3", result.stdout)
+        self.assertFalse(os.path.exists(self.path("out", "evaluation.json")))
+
+    def test_malformed_model_fails_cleanly(self):
+        write_model(self.path("gt"), ground_truth_poses())
+        write_model(self.path("estimate"), ground_truth_poses())
+        with open(self.path("estimate", "images.txt"), "w") as f:
+            f.write("1 not a pose\n\n")
+        result = self.evaluate(self.path("gt"), self.path("estimate"),
+                               check=False)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn(self.path("estimate"), result.stdout)
+        self.assertFalse(os.path.exists(self.path("out", "evaluation.json")))
+
+
+class StrechaImporterTest(TempDirTestCase):
+    def write_camera(self, name, text):
+        os.makedirs(self.path("cams"), exist_ok=True)
+        with open(self.path("cams", name + ".camera"), "w") as f:
+            f.write(text)
+
+    def test_convention_and_values(self):
+        # R (camera-to-world) = rotation of 90 degrees about z, centre C.
+        self.write_camera("a.jpg", "1000 0 500\n0 1100 400\n0 0 1\n0 0 0\n"
+                          "0 -1 0\n1 0 0\n0 0 1\n1 2 3\n1000 800\n")
+        os.makedirs(self.path("model"))
+        run_colmap("strecha_importer", "--input_path", self.path("cams"),
+                   "--output_path", self.path("model"))
+        with open(self.path("model", "cameras.txt")) as f:
+            camera = [l for l in f if not l.startswith("#")][0].split()
+        self.assertEqual(camera[1:], ["PINHOLE", "1000", "800", "1000", "1100",
+                                      "500", "400"])
+        with open(self.path("model", "images.txt")) as f:
+            image = [l for l in f if not l.startswith("#")][0].split()
+        q = tuple(map(float, image[1:5]))
+        t = tuple(map(float, image[5:8]))
+        center = Pose(q, t).center()
+        for got, expected in zip(center, (1, 2, 3)):
+            self.assertAlmostEqual(got, expected, places=9)
+        # cam_from_world = R^T: the world x axis is the camera's -y axis.
+        x_in_cam = quat_rotate(q, (1, 0, 0))
+        for got, expected in zip(x_in_cam, (0, -1, 0)):
+            self.assertAlmostEqual(got, expected, places=9)
+        self.assertEqual(image[9], "a.jpg")
+
+    def test_malformed_file_is_named(self):
+        self.write_camera("bad.jpg", "1000 0 500\n0 1100\n")
+        os.makedirs(self.path("model"))
+        result = run_colmap("strecha_importer", "--input_path",
+                            self.path("cams"), "--output_path",
+                            self.path("model"), check=False)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("bad.jpg.camera:2", result.stdout)
+
+    @unittest.skipUnless(os.path.isdir(os.path.join(
+        SHARED_DATA, "strecha", "fountain-P11")), "needs ../shared/data")
+    def test_fountain_ground_truth_imports(self):
+        os.makedirs(self.path("model"))
+        run_colmap("strecha_importer", "--input_path",
+                   os.path.join(SHARED_DATA, "strecha", "fountain-P11",
+                                "gt_dense_cameras"),
+                   "--output_path", self.path("model"))
+        with open(self.path("model", "images.txt")) as f:
+            names = [l.split()[9] for l in f
+                     if not l.startswith("#") and len(l.split()) == 10]
+        self.assertEqual(len(names), 11)
+        self.assertIn("0000.jpg", names)
+
+
+if __name__ == "__main__":
+    unittest.main()
