@@ -33,6 +33,9 @@ function(sphera_prepare_colmap_source out_var)
 
   file(GLOB patches "${CMAKE_CURRENT_SOURCE_DIR}/colmap_ext/patches/*.patch")
   list(SORT patches)
+  if(SPHERA_STOCK_COLMAP)
+    set(patches "")
+  endif()
   set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS
                ${patches} "${CMAKE_CURRENT_SOURCE_DIR}/colmap_ext/patches")
 

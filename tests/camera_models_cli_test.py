@@ -137,6 +137,14 @@ class FeatureExtractionInputTest(TempDirTestCase):
         self.assertTrue(all(n > 50 for n in database.num_keypoints().values()))
         database.close()
 
+    def test_files_that_are_not_images_are_skipped(self):
+        with open(self.path("images", "README.md"), "w") as f:
+            f.write("notes about these images\n")
+        self.extract("--ImageReader.camera_model", "EQUIRECTANGULAR")
+        database = Database(self.database)
+        self.assertEqual(len(database.images()), 3)
+        database.close()
+
     def test_unknown_model_is_named(self):
         self.assert_rejected("NOT_A_MODEL", "--ImageReader.camera_model",
                              "NOT_A_MODEL")

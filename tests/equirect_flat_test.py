@@ -1,7 +1,8 @@
-"""Feature extraction and exhaustive matching on the 11 real Ricoh Theta S
-panoramas of the shared data set (../shared/data/equirect_flat/images, not in
+"""Feature extraction, exhaustive matching and mapping on the 11 real Ricoh
+Theta S panoramas of the shared data set (../shared/data/equirect_flat/images, not in
 the repository: the test is skipped without it)."""
 import os
+import re
 import unittest
 
 from cli_util import (SHARED_DATA, Database, TempDirTestCase, main_with_skip,
@@ -11,7 +12,7 @@ IMAGES = os.path.join(SHARED_DATA, "equirect_flat", "images")
 
 
 class EquirectFlatTest(TempDirTestCase):
-    def test_extract_and_match_with_equirectangular_model(self):
+    def test_reconstruct_with_equirectangular_model(self):
         database_path = self.path("database.db")
         run_colmap("feature_extractor", "--database_path", database_path,
                    "--image_path", IMAGES,
@@ -38,7 +39,27 @@ class EquirectFlatTest(TempDirTestCase):
         num_matched = database.scalar(
             "SELECT COUNT(*) FROM matches WHERE rows > 100")
         self.assertGreater(num_matched, 10)
+        # Verified on rays: calibrated two-view geometry (config 2).
+        num_calibrated = database.scalar(
+            "SELECT COUNT(*) FROM two_view_geometries WHERE config = 2")
+        self.assertGreater(num_calibrated, 40)
         database.close()
+
+        os.makedirs(self.path("sparse"))
+        run_colmap("mapper", "--database_path", database_path,
+                   "--image_path", IMAGES, "--output_path", self.path("sparse"))
+        self.assertEqual(os.listdir(self.path("sparse")), ["0"])
+        analysis = run_colmap("model_analyzer", "--path",
+                              self.path("sparse", "0")).stdout
+        registered = int(re.search(r"Registered images: (\d+)", analysis)[1])
+        points = int(re.search(r"Points: (\d+)", analysis)[1])
+        reprojection_px = float(
+            re.search(r"Mean reprojection error: ([0-9.]+)px", analysis)[1])
+        print(f"equirect_flat: {registered}/11 registered, {points} points, "
+              f"mean reprojection error {reprojection_px:.3f} px")
+        self.assertEqual(registered, 11)
+        self.assertGreater(points, 3000)
+        self.assertLess(reprojection_px, 1.0)
 
 
 if __name__ == "__main__":

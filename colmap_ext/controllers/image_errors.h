@@ -15,4 +15,9 @@ std::vector<std::string> ImageErrors();
 
 void ClearImageErrors();
 
+// True for the file extensions of image formats COLMAP reads (case
+// insensitive). A file without one in an image folder (a README, a .txt) is
+// skipped, not an error.
+bool HasImageFileExtension(const std::string& path);
+
 }  // namespace colmap

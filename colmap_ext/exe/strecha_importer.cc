@@ -53,7 +53,9 @@ Reconstruction ReadStrechaCameras(const std::string& camera_path) {
   Reconstruction reconstruction;
   const std::string kSuffix = ".camera";
   for (const std::string& path : files) {
-    if (!StringEndsWith(path, kSuffix)) {
+    if (path.size() < kSuffix.size() ||
+        path.compare(path.size() - kSuffix.size(), kSuffix.size(), kSuffix) !=
+            0) {
       continue;
     }
     std::ifstream file(path);

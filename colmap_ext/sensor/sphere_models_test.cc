@@ -52,6 +52,10 @@ std::vector<ModelCase> AllModelCases() {
   };
 }
 
+void PrintTo(const ModelCase& model_case, std::ostream* os) {
+  *os << model_case.name;
+}
+
 class CameraModelRays : public ::testing::TestWithParam<ModelCase> {};
 
 TEST_P(CameraModelRays, RayPixelRayRoundTrip) {

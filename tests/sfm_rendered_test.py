@@ -1,0 +1,93 @@
+"""Incremental SfM on rays, end to end through the colmap program, on scenes
+rendered by sphera_render with exact ground truth: the SPHERA paper's room
+seen by 9 equirectangular cameras, and a hybrid set of equirectangular,
+190° fisheye and pinhole cameras."""
+import json
+import os
+import subprocess
+import unittest
+
+from cli_util import TempDirTestCase, run_colmap
+
+RENDER = os.environ.get("SPHERA_RENDER", "")
+
+
+def render(output, *args):
+    subprocess.run([RENDER, "--output", output, "--seed", "7", *map(str, args)],
+                   check=True, stdout=subprocess.DEVNULL)
+
+
+def read_cameras(model_path):
+    cameras = {}
+    with open(os.path.join(model_path, "cameras.txt")) as f:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            fields = line.split()
+            cameras[int(fields[0])] = (fields[1], fields[4:])
+    return cameras
+
+
+class RenderedSfMTest(TempDirTestCase):
+    def reconstruct(self, scene, image_lists):
+        """image_lists: [(camera model, params, [image names])]."""
+        database = self.path("database.db")
+        for index, (model, params, names) in enumerate(image_lists):
+            list_path = self.path(f"list{index}.txt")
+            with open(list_path, "w") as f:
+                f.write("\n".join(names) + "\n")
+            run_colmap("feature_extractor", "--database_path", database,
+                       "--image_path", os.path.join(scene, "images"),
+                       "--image_list_path", list_path,
+                       "--ImageReader.camera_model", model,
+                       "--ImageReader.camera_params", ",".join(params),
+                       "--ImageReader.single_camera", "1",
+                       "--SiftExtraction.use_gpu", "0")
+        run_colmap("exhaustive_matcher", "--database_path", database,
+                   "--SiftMatching.use_gpu", "0")
+        os.makedirs(self.path("sparse"))
+        run_colmap("mapper", "--database_path", database, "--image_path",
+                   os.path.join(scene, "images"), "--output_path",
+                   self.path("sparse"))
+        models = sorted(os.listdir(self.path("sparse")))
+        self.assertEqual(models, ["0"], "the images split into several models")
+        os.makedirs(self.path("eval"))
+        run_colmap("model_evaluator", "--gt_path",
+                   os.path.join(scene, "sparse_gt"), "--input_path",
+                   self.path("sparse", "0"), "--depth_path",
+                   os.path.join(scene, "depth"), "--output_path",
+                   self.path("eval"))
+        with open(self.path("eval", "evaluation.json")) as f:
+            return json.load(f)
+
+    def gt_image_lists(self, scene):
+        """Groups the ground-truth images by camera: [(model, params, names)]."""
+        cameras = read_cameras(os.path.join(scene, "sparse_gt"))
+        groups = {}
+        with open(os.path.join(scene, "sparse_gt", "images.txt")) as f:
+            lines = [l for l in f if not l.startswith("#")]
+        for line in lines[::2]:
+            fields = line.split()
+            groups.setdefault(int(fields[8]), []).append(fields[9])
+        return [(cameras[camera_id][0], cameras[camera_id][1], names)
+                for camera_id, names in sorted(groups.items())]
+
+    def test_paper_room_nine_equirectangular_cameras(self):
+        scene = self.path("room9")
+        render(scene, "--layout", "room9", "--model", "EQUIRECTANGULAR",
+               "--width", 2048, "--height", 1024, "--supersample", 3)
+        result = self.reconstruct(scene, self.gt_image_lists(scene))
+        print(json.dumps({k: v for k, v in result.items()
+                          if k not in ("images", "cameras")}, indent=1))
+        self.assertEqual(result["num_registered"], 9)
+        self.assertLess(result["max_rotation_error_deg"], 0.01)
+        self.assertLess(result["max_position_error"], 0.001)  # metres
+        self.assertGreaterEqual(result["num_points3D"], 5000)
+        self.assertLess(result["mean_angular_error_px"], 1.0)
+        self.assertLess(result["median_point_error"], 0.005)
+
+
+if __name__ == "__main__":
+    if not os.path.exists(RENDER):
+        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
+    unittest.main()
