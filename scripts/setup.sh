@@ -12,7 +12,7 @@ readonly PACKAGES=(
   libeigen3-dev libgoogle-glog-dev libgflags-dev libceres-dev libflann-dev
   libfreeimage-dev libmetis-dev libsqlite3-dev libboost-program-options-dev
   libboost-filesystem-dev libboost-graph-dev libboost-system-dev
-  libsuitesparse-dev libgtest-dev
+  libsuitesparse-dev libgtest-dev libgl-dev
   # SPHERA: bearing-vector solvers, image remapping
   libopengv-dev libopencv-dev
   # tests, benchmarks and plots
@@ -38,6 +38,6 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 echo "setup: installing ${missing[*]}"
 ${SUDO} apt-get update -qq
-DEBIAN_FRONTEND=noninteractive ${SUDO} apt-get install -y -qq --no-install-recommends \
+DEBIAN_FRONTEND=noninteractive ${SUDO} apt-get install -y -qq \
   "${missing[@]}" >/dev/null
 echo "setup: done"

@@ -86,6 +86,18 @@ class RenderedSfMTest(TempDirTestCase):
         self.assertLess(result["mean_angular_error_px"], 1.0)
         self.assertLess(result["median_point_error"], 0.005)
 
+    def test_perspective_ring_keeps_colmap_behaviour(self):
+        # Perspective-only data runs COLMAP's own estimators.
+        scene = self.path("ring")
+        render(scene, "--layout", "ring", "--supersample", 3)
+        result = self.reconstruct(scene, self.gt_image_lists(scene))
+        print(json.dumps({k: v for k, v in result.items()
+                          if k not in ("images", "cameras")}, indent=1))
+        self.assertEqual(result["num_registered"], result["num_gt_images"])
+        self.assertGreaterEqual(result["num_gt_images"], 12)
+        self.assertLess(result["max_rotation_error_deg"], 0.1)
+        self.assertLess(result["max_position_error"], 0.04)  # 1% of 4 m
+
 
 if __name__ == "__main__":
     if not os.path.exists(RENDER):
