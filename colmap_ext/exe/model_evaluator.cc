@@ -6,6 +6,7 @@
 #include "colmap/math/math.h"
 #include "colmap/util/logging.h"
 #include "colmap/util/misc.h"
+#include "estimators/similarity_alignment.h"
 
 #include <cstdint>
 #include <cstdio>
@@ -158,6 +159,40 @@ ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
     throw std::invalid_argument(
         "no similarity aligns the camera centres within " +
         std::to_string(max_proj_center_error) + " (ground-truth units)");
+  }
+
+  // Refine: rotation from the camera orientations (geodesic median, robust to
+  // a minority of wrong cameras), scale and translation from the centres that
+  // the robust centre alignment kept.
+  std::vector<Eigen::Matrix3d> world_rotations;
+  std::vector<Eigen::Vector3d> inlier_centers;
+  std::vector<Eigen::Vector3d> inlier_gt_centers;
+  for (const auto& [image_id, gt_image_id] : common_image_ids) {
+    const Image& image = reconstruction.Image(image_id);
+    const Image& gt_image = ground_truth.Image(gt_image_id);
+    world_rotations.push_back(
+        gt_image.CamFromWorld().rotation.toRotationMatrix().transpose() *
+        image.CamFromWorld().rotation.toRotationMatrix());
+    if ((gt_from_reconstruction * image.ProjectionCenter() -
+         gt_image.ProjectionCenter())
+            .norm() <= max_proj_center_error) {
+      inlier_centers.push_back(image.ProjectionCenter());
+      inlier_gt_centers.push_back(gt_image.ProjectionCenter());
+    }
+  }
+  const Eigen::Matrix3d gt_from_reconstruction_rotation =
+      sphera::GeodesicMedianRotation(world_rotations);
+  double scale = 0;
+  Eigen::Vector3d translation;
+  if (sphera::AlignCentersWithRotation(inlier_centers,
+                                       inlier_gt_centers,
+                                       gt_from_reconstruction_rotation,
+                                       &scale,
+                                       &translation)) {
+    gt_from_reconstruction =
+        Sim3d(scale,
+              Eigen::Quaterniond(gt_from_reconstruction_rotation),
+              translation);
   }
 
   evaluation.closest_pair_baseline = ClosestPairBaseline(ground_truth);

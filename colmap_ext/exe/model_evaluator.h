@@ -57,8 +57,9 @@ struct ModelEvaluation {
 };
 
 // Aligns `reconstruction` to `ground_truth` by a robust similarity on camera
-// centres (no reprojection involved, so any camera model works) and measures
-// the errors. Throws std::invalid_argument with a message when the models
+// centres (no reprojection involved, so any camera model works), refined with
+// its rotation taken from the camera orientations
+// (estimators/similarity_alignment.h), and measures the errors. Throws std::invalid_argument with a message when the models
 // cannot be compared (fewer than 3 common registered images, no alignment).
 ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
                               const Reconstruction& reconstruction,
