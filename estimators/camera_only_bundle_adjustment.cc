@@ -50,31 +50,30 @@ const char* CameraOnlyBAStatusName(CameraOnlyBAStatus status) {
 
 namespace {
 
-// Angular residual of a fixed world point X in a camera parametrised by its
+// Angular residual of a world point X in a camera parametrised by its
 // rotation q (Eigen order [x, y, z, w]) and its centre C = offset + scale * c:
 //   r = Log_u(R(q) (X - C)),  |r| = angle(u, R (X - C)).
 class PoseCenterAngularCost {
  public:
-  PoseCenterAngularCost(const Eigen::Vector3d& ray, const Eigen::Vector3d& X,
+  PoseCenterAngularCost(const Eigen::Vector3d& ray,
                         const Eigen::Vector3d& offset, double scale)
-      : u_(ray.normalized()), X_(X), offset_(offset), scale_(scale) {
+      : u_(ray.normalized()), offset_(offset), scale_(scale) {
     RayTangentBasis(u_, &e1_, &e2_);
   }
 
   static ceres::CostFunction* Create(const Eigen::Vector3d& ray,
-                                     const Eigen::Vector3d& X,
                                      const Eigen::Vector3d& offset,
                                      double scale) {
-    return new ceres::AutoDiffCostFunction<PoseCenterAngularCost, 2, 4, 3>(
-        new PoseCenterAngularCost(ray, X, offset, scale));
+    return new ceres::AutoDiffCostFunction<PoseCenterAngularCost, 2, 4, 3, 3>(
+        new PoseCenterAngularCost(ray, offset, scale));
   }
 
   template <typename T>
-  bool operator()(const T* const q_xyzw, const T* const c,
+  bool operator()(const T* const q_xyzw, const T* const c, const T* const X,
                   T* residuals) const {
     T d[3];
     for (int k = 0; k < 3; ++k) {
-      d[k] = T(X_(k)) - (T(offset_(k)) + T(scale_) * c[k]);
+      d[k] = X[k] - (T(offset_(k)) + T(scale_) * c[k]);
     }
     const T q_wxyz[4] = {q_xyzw[3], q_xyzw[0], q_xyzw[1], q_xyzw[2]};
     T v[3];
@@ -87,7 +86,7 @@ class PoseCenterAngularCost {
   }
 
  private:
-  Eigen::Vector3d u_, e1_, e2_, X_, offset_;
+  Eigen::Vector3d u_, e1_, e2_, offset_;
   double scale_;
 };
 
@@ -186,7 +185,7 @@ double PoseConditioning(const CameraPose& pose,
   return std::max(0.0, es.eigenvalues().minCoeff()) / max_ev;
 }
 
-struct ObservationRef {
+struct ObservationRef {  // an observation of a reliable point
   int point_idx;
   int obs_idx;  // index in the track
 };
@@ -415,67 +414,119 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
     stats.mean_error_before_rad = sum_err / n_obs;
     if (iter == 1) result.initial_mean_error_rad = stats.mean_error_before_rad;
 
-    // ---- Pose step: one small problem per camera (the points are fixed,
-    // so the normal equations are block diagonal). ----
+    // ---- Pose step (Eq. 6) over the reliable points. ----
+    // kFixed: the points are constants (resection of every camera, block
+    // diagonal). kImplicit: the points enter as functions of the poses: they
+    // are nuisance blocks, eliminated by the Schur complement in every
+    // Gauss-Newton step (variable projection), then discarded; the next
+    // iteration re-triangulates them from the new poses.
+    const bool implicit_points = options.points == PointHandling::kImplicit;
+    std::vector<Eigen::Vector4d> qs(num_images);
+    std::vector<Eigen::Vector3d> cs(num_images);
+    std::vector<Eigen::Vector3d> offsets(num_images, Eigen::Vector3d::Zero());
+    std::vector<double> scales(num_images, 1.0);
+    for (int i = 0; i < num_images; ++i) {
+      qs[i] = poses[i].rotation.coeffs();  // x, y, z, w
+      cs[i] = poses[i].Center();
+      if (fix_gauge && i == g1) {
+        offsets[i] = poses[g0].Center();
+        scales[i] = gauge_distance;
+        cs[i] = (cs[i] - offsets[i]) / scales[i];
+      }
+    }
+    std::vector<Eigen::Vector3d> xyz(points.size());
+    for (size_t p = 0; p < points.size(); ++p) xyz[p] = points[p].xyz;
+    {
+      ceres::Problem ceres_problem;
+      auto* ordering = new ceres::ParameterBlockOrdering;
+      for (size_t p = 0; p < points.size(); ++p) {
+        const RayTrack& track = tracks[points[p].track_idx];
+        for (const auto& obs : track) {
+          const int i = obs.image_idx;
+          ceres::LossFunction* loss =
+              options.loss == CameraOnlyBALoss::kCauchy
+                  ? new ceres::CauchyLoss(options.loss_scale_rad)
+                  : nullptr;
+          ceres_problem.AddResidualBlock(
+              PoseCenterAngularCost::Create(obs.ray, offsets[i], scales[i]),
+              loss, qs[i].data(), cs[i].data(), xyz[p].data());
+        }
+        if (implicit_points) {
+          ordering->AddElementToGroup(xyz[p].data(), 0);
+        } else {
+          ceres_problem.SetParameterBlockConstant(xyz[p].data());
+        }
+      }
+      for (int i = 0; i < num_images; ++i) {
+        if (!ceres_problem.HasParameterBlock(qs[i].data())) continue;
+        ceres_problem.SetManifold(qs[i].data(),
+                                  new ceres::EigenQuaternionManifold);
+        if (fix_gauge && i == g0) {
+          ceres_problem.SetParameterBlockConstant(qs[i].data());
+          ceres_problem.SetParameterBlockConstant(cs[i].data());
+        } else if (fix_gauge && i == g1) {
+          ceres_problem.SetManifold(cs[i].data(), new ceres::SphereManifold<3>);
+        }
+        ordering->AddElementToGroup(qs[i].data(), 1);
+        ordering->AddElementToGroup(cs[i].data(), 1);
+      }
+      ceres::Solver::Options solver_options;
+      const bool sparse = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(
+          ceres::SUITE_SPARSE);
+      if (implicit_points) {
+        solver_options.linear_solver_type =
+            sparse && num_images > 50 ? ceres::SPARSE_SCHUR
+                                      : ceres::DENSE_SCHUR;
+        solver_options.linear_solver_ordering.reset(ordering);
+      } else {
+        delete ordering;
+        solver_options.linear_solver_type =
+            sparse ? ceres::SPARSE_NORMAL_CHOLESKY : ceres::DENSE_QR;
+      }
+      solver_options.max_num_iterations = options.max_num_pose_iterations;
+      // Tight, but above the round-off of the cost (a tighter tolerance
+      // ends in "invalid steps" at the optimum).
+      solver_options.function_tolerance = 1e-14;
+      solver_options.gradient_tolerance = 1e-20;
+      solver_options.parameter_tolerance = 1e-14;
+      solver_options.num_threads = std::max(1, options.num_threads);
+      solver_options.logging_type = ceres::SILENT;
+      ceres::Solver::Summary summary;
+      ceres::Solve(solver_options, &ceres_problem, &summary);
+      // Ceres keeps the last accepted state; a FAILURE termination after
+      // repeated invalid steps at the optimum (round-off) is still usable.
+      bool finite = true;
+      for (int i = 0; i < num_images; ++i) {
+        finite = finite && qs[i].allFinite() && cs[i].allFinite();
+      }
+      for (const auto& X : xyz) finite = finite && X.allFinite();
+      if (!finite ||
+          !(summary.final_cost <= summary.initial_cost * (1 + 1e-12))) {
+        return finish(CameraOnlyBAStatus::kSolverFailure,
+                      "the pose step failed: " + summary.BriefReport());
+      }
+    }
     std::vector<CameraPose> new_poses = poses;
     for (int i = 0; i < num_images; ++i) {
       if (fix_gauge && i == g0) continue;
-      Eigen::Vector4d q = poses[i].rotation.coeffs();  // x, y, z, w
-      Eigen::Vector3d c = poses[i].Center();
-      Eigen::Vector3d offset = Eigen::Vector3d::Zero();
-      double scale = 1;
-      const bool on_sphere = fix_gauge && i == g1;
-      if (on_sphere) {
-        offset = poses[g0].Center();
-        scale = gauge_distance;
-        c = (c - offset) / scale;
-      }
-      ceres::Problem::Options problem_options;
-      ceres::Problem ceres_problem(problem_options);
-      for (const auto& ref : refs[i]) {
-        ceres::LossFunction* loss =
-            options.loss == CameraOnlyBALoss::kCauchy
-                ? new ceres::CauchyLoss(options.loss_scale_rad)
-                : nullptr;
-        ceres_problem.AddResidualBlock(
-            PoseCenterAngularCost::Create(
-                tracks[points[ref.point_idx].track_idx][ref.obs_idx].ray,
-                points[ref.point_idx].xyz, offset, scale),
-            loss, q.data(), c.data());
-      }
-      ceres_problem.SetManifold(q.data(), new ceres::EigenQuaternionManifold);
-      if (on_sphere) {
-        ceres_problem.SetManifold(c.data(), new ceres::SphereManifold<3>);
-      }
-      ceres::Solver::Options solver_options;
-      solver_options.linear_solver_type = ceres::DENSE_QR;
-      solver_options.max_num_iterations = options.max_num_pose_iterations;
-      solver_options.function_tolerance = 1e-16;
-      solver_options.gradient_tolerance = 1e-20;
-      solver_options.parameter_tolerance = 1e-16;
-      solver_options.num_threads = std::max(1, options.num_threads);
-      solver_options.logging_type = ceres::SILENT;
-      if (getenv("CBA_DEBUG") && on_sphere) { solver_options.minimizer_progress_to_stdout = true; solver_options.logging_type = ceres::PER_MINIMIZER_ITERATION; }
-      ceres::Solver::Summary summary;
-      ceres::Solve(solver_options, &ceres_problem, &summary);
-      if (!summary.IsSolutionUsable() || !q.allFinite() || !c.allFinite()) {
-        return finish(CameraOnlyBAStatus::kSolverFailure,
-                      "the pose step of image " + std::to_string(i) +
-                          " failed: " + summary.BriefReport());
-      }
       CameraPose& pose = new_poses[i];
-      pose.rotation = Eigen::Quaterniond(q(3), q(0), q(1), q(2)).normalized();
-      const Eigen::Vector3d center = offset + scale * c;
+      pose.rotation =
+          Eigen::Quaterniond(qs[i](3), qs[i](0), qs[i](1), qs[i](2))
+              .normalized();
+      const Eigen::Vector3d center = offsets[i] + scales[i] * cs[i];
       pose.translation = -(pose.rotation * center);
     }
 
-    // Stats after the pose step (same points and observations).
+    // Stats after the pose step (same observations; points as optimised,
+    // which is also what the intrinsics step sees).
     sum_err = 0;
-    for (const auto& p : points) {
-      const RayTrack& track = tracks[p.track_idx];
+    for (size_t p = 0; p < points.size(); ++p) {
+      const RayTrack& track = tracks[points[p].track_idx];
+      points[p].xyz = xyz[p];
       for (size_t k = 0; k < track.size(); ++k) {
         const double e = RayAngularError(
-            track[k].ray, new_poses[track[k].image_idx].Matrix(), p.xyz);
+            track[k].ray, new_poses[track[k].image_idx].Matrix(), xyz[p]);
+        points[p].errors_rad[k] = e;
         sum_err += e;
         stats.cost_after += 0.5 * Rho(options, e * e);
       }
@@ -502,10 +553,11 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
     }
 
     if (options.intrinsics_step) {
-      if (!options.intrinsics_step(poses, points, &tracks)) {
+      if (!options.intrinsics_step(&poses, points, &tracks)) {
         return finish(CameraOnlyBAStatus::kSolverFailure,
                       "the intrinsics step failed");
       }
+      result.poses = poses;
       for (auto& track : tracks) {
         for (auto& obs : track) {
           if (!obs.ray.allFinite() || !(obs.ray.norm() > 0)) {

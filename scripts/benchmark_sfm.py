@@ -523,19 +523,19 @@ class Benchmark:
             step = "feature_extractor" + ("_%d" % index if len(groups) > 1 else "")
             seconds, _ = run_step(step, command, logs, timeout)
             t_extract += seconds
-        row["t_extract_s"] = t_extract
+        row["t_extract_s"] = round(t_extract, 3)
         seconds, _ = run_step("exhaustive_matcher",
                               [colmap, "exhaustive_matcher", "--database_path",
                                database, "--SiftMatching.use_gpu", "0"],
                               logs, timeout)
-        row["t_match_s"] = seconds
+        row["t_match_s"] = round(seconds, 3)
         sparse = os.path.join(run_dir, "sparse")
         os.makedirs(sparse, exist_ok=True)
         seconds, _ = run_step("mapper",
                               [colmap, "mapper", "--database_path", database,
                                "--image_path", image_path, "--output_path",
                                sparse], logs, timeout)
-        row["t_map_s"] = seconds
+        row["t_map_s"] = round(seconds, 3)
         models = sparse_models(sparse)
         row["num_models"] = len(models)
         if not models:

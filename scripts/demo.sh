@@ -33,7 +33,7 @@ mkdir -p "${WORK_DIR}"
 if [ -z "${image_dir}" ]; then
   echo "demo: rendering the default scene into ${WORK_DIR}/scene"
   "${RENDER}" --output "${WORK_DIR}/scene" --layout room9 \
-    --model EQUIRECTANGULAR --width 2048 --height 1024 --seed 1
+    --model EQUIRECTANGULAR --width 2048 --height 1024 --seed 1 --supersample 2
   image_dir="${WORK_DIR}/scene/images"
 fi
 
@@ -54,6 +54,13 @@ echo "=== SPHERA demo summary (${elapsed} s) ==="
 echo "images:          $(sqlite3 "${database}" 'SELECT COUNT(*) FROM images')"
 echo "keypoints:       $(sqlite3 "${database}" 'SELECT SUM(rows) FROM keypoints')"
 echo "verified pairs:  $(sqlite3 "${database}" 'SELECT COUNT(*) FROM two_view_geometries WHERE rows > 0')"
+if [ -d "${WORK_DIR}/scene/sparse_gt" ] && [ -d "${WORK_DIR}/sparse/0" ]; then
+  echo "--- against the ground truth (colmap model_evaluator) ---"
+  mkdir -p "${WORK_DIR}/evaluation"
+  "${COLMAP}" model_evaluator --gt_path "${WORK_DIR}/scene/sparse_gt" \
+    --input_path "${WORK_DIR}/sparse/0" --depth_path "${WORK_DIR}/scene/depth" \
+    --output_path "${WORK_DIR}/evaluation" 2>/dev/null | tail -n 7
+fi
 for model in "${WORK_DIR}"/sparse/*/; do
   [ -d "${model}" ] || continue
   "${COLMAP}" model_analyzer --path "${model}" 2>&1 \

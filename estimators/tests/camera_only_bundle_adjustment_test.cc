@@ -157,6 +157,27 @@ TEST(CameraOnlyBundleAdjustment, NoiseFreeRecoversPoses) {
   }
 }
 
+TEST(CameraOnlyBundleAdjustment, FixedPointsAlternationDecreasesError) {
+  std::mt19937 rng(43);
+  const Scene scene = MakeRoom(100, &rng);
+  CameraOnlyBAProblem problem;
+  problem.poses = PerturbPoses(scene.poses, 0.5 * M_PI / 180, 0.02, &rng);
+  problem.tracks = scene.tracks;
+  CameraOnlyBAOptions options;
+  options.tau_rad = {0.1};
+  options.points = PointHandling::kFixed;
+  options.max_iterations = 10;
+  options.function_tolerance = 0;
+  const CameraOnlyBAResult result =
+      CameraOnlyBundleAdjustment(problem, options);
+  ASSERT_TRUE(result.Success()) << result.message;
+  ASSERT_EQ(result.iterations.size(), 10u);
+  for (const auto& it : result.iterations) {
+    EXPECT_LT(it.cost_after, it.cost_before);
+  }
+  EXPECT_LT(result.final_mean_error_rad, 0.5 * result.initial_mean_error_rad);
+}
+
 TEST(CameraOnlyBundleAdjustment, TauExcludesOutliers) {
   std::mt19937 rng(7);
   Scene scene = MakeRoom(300, &rng);
@@ -199,8 +220,9 @@ TEST(CameraOnlyBundleAdjustment, TauExcludesOutliers) {
                                          outlier_tracks.size()));
   double rot, pos;
   PoseErrors(scene.poses, result.poses, &rot, &pos);
-  EXPECT_LT(rot, 0.02);
-  EXPECT_LT(pos, 2e-3);
+  // From 0.5 deg / 2 cm to the noise level (sigma = 0.09 deg per ray).
+  EXPECT_LT(rot, 0.05);
+  EXPECT_LT(pos, 3e-3);
   EXPECT_LT(result.final_mean_error_rad, 2 * sigma);
 }
 
@@ -335,11 +357,11 @@ TEST(CameraOnlyBundleAdjustment, IntrinsicsStepAndCauchy) {
   options.loss_scale_rad = 0.01;
   options.max_iterations = 3;
   int calls = 0;
-  options.intrinsics_step = [&](const std::vector<CameraPose>& poses,
+  options.intrinsics_step = [&](std::vector<CameraPose>* poses,
                                 const std::vector<ReliablePoint>& points,
                                 std::vector<RayTrack>* tracks) {
     ++calls;
-    EXPECT_EQ(poses.size(), 9u);
+    EXPECT_EQ(poses->size(), 9u);
     EXPECT_FALSE(points.empty());
     EXPECT_EQ(tracks->size(), scene.tracks.size());
     return true;
@@ -349,7 +371,7 @@ TEST(CameraOnlyBundleAdjustment, IntrinsicsStepAndCauchy) {
   EXPECT_EQ(calls, static_cast<int>(r.iterations.size()));
   EXPECT_LT(r.final_mean_error_rad, r.initial_mean_error_rad);
 
-  options.intrinsics_step = [](const std::vector<CameraPose>&,
+  options.intrinsics_step = [](std::vector<CameraPose>*,
                                const std::vector<ReliablePoint>&,
                                std::vector<RayTrack>*) { return false; };
   EXPECT_EQ(CameraOnlyBundleAdjustment(problem, options).status,
