@@ -633,6 +633,27 @@ bool SphereBundleAdjust(const SphereBundleAdjusterOptions& options,
   return true;
 }
 
+void RunCameraOnlyRefinement(const double tau_px,
+                             Reconstruction* reconstruction) {
+  SphereBundleAdjusterOptions options;
+  options.mode = "camera_only";
+  options.tau_px = tau_px;
+  SphereBundleAdjusterSummary summary;
+  std::string error;
+  if (SphereBundleAdjust(options, reconstruction, &summary, &error)) {
+    LOG(INFO) << "Camera-only bundle adjustment (tau " << tau_px << " px): "
+              << summary.iterations << " iterations, points "
+              << summary.num_points_before << " -> "
+              << summary.num_points_after << ", mean error "
+              << summary.mean_error_before_px << " -> "
+              << summary.mean_error_after_px << " px";
+  } else {
+    LOG(WARNING) << "Camera-only bundle adjustment skipped, the model is "
+                    "unchanged: "
+                 << error;
+  }
+}
+
 int RunSphereBundleAdjuster(int argc, char** argv) {
   std::string input_path;
   std::string output_path;

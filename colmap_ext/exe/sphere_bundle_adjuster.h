@@ -81,6 +81,12 @@ bool SphereBundleAdjust(const SphereBundleAdjusterOptions& options,
                         SphereBundleAdjusterSummary* summary,
                         std::string* error);
 
+// The mapper's option Mapper.camera_only_ba_tau_px: camera-only adjustment
+// of a finished reconstruction in place, with a log line of what it did; on
+// failure (e.g. tau below the noise floor) the reconstruction is kept as it
+// was and a warning names the reason.
+void RunCameraOnlyRefinement(double tau_px, Reconstruction* reconstruction);
+
 int RunSphereBundleAdjuster(int argc, char** argv);
 
 }  // namespace colmap
