@@ -8,6 +8,7 @@
 #include <opengv/absolute_pose/methods.hpp>
 
 #include "estimators/angular_residual.h"
+#include "estimators/solver_options.h"
 
 namespace sphera {
 namespace {
@@ -145,14 +146,8 @@ bool RefineAbsolutePose(const std::vector<Eigen::Vector3d>& rays,
   if (num_used < 3) return false;
   problem.SetManifold(q.data(), new ceres::QuaternionManifold);
 
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_num_iterations;
-  solver_options.function_tolerance = 1e-14;
-  solver_options.gradient_tolerance = 1e-16;
-  solver_options.parameter_tolerance = 1e-14;
-  solver_options.num_threads = 1;
-  solver_options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options solver_options =
+      SmallProblemSolverOptions(options.max_num_iterations);
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
   if (!summary.IsSolutionUsable() || !q.allFinite() || !t.allFinite()) {

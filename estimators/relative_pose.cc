@@ -12,6 +12,7 @@
 #include <opengv/relative_pose/methods.hpp>
 
 #include "estimators/angular_residual.h"
+#include "estimators/solver_options.h"
 
 namespace sphera {
 namespace {
@@ -395,14 +396,8 @@ bool RefineRelativePose(const std::vector<Eigen::Vector3d>& rays1,
   problem.SetManifold(q.data(), new ceres::QuaternionManifold);
   problem.SetManifold(t.data(), new ceres::SphereManifold<3>);
 
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_num_iterations;
-  solver_options.function_tolerance = 1e-14;
-  solver_options.gradient_tolerance = 1e-16;
-  solver_options.parameter_tolerance = 1e-14;
-  solver_options.num_threads = 1;
-  solver_options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options solver_options =
+      SmallProblemSolverOptions(options.max_num_iterations);
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
   if (!summary.IsSolutionUsable() || !q.allFinite() || !t.allFinite()) {

@@ -7,6 +7,7 @@
 #include <ceres/ceres.h>
 
 #include "estimators/angular_residual.h"
+#include "estimators/solver_options.h"
 
 namespace sphera {
 
@@ -114,14 +115,8 @@ bool RefineTriangulatedPoint(
             cams_from_world[i].col(3)),
         nullptr, point3D->data());
   }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
-  options.max_num_iterations = max_num_iterations;
-  options.function_tolerance = 1e-14;
-  options.gradient_tolerance = 1e-16;
-  options.parameter_tolerance = 1e-14;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options options =
+      SmallProblemSolverOptions(max_num_iterations);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   return summary.IsSolutionUsable() && point3D->allFinite();

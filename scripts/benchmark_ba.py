@@ -11,7 +11,7 @@ is refined by `colmap sphere_bundle_adjuster` in each mode:
 Each result is scored by `colmap model_evaluator` against the ground truth
 (orientation, position, mean reprojection error, 3D point error vs depth).
 
-Usage (from the repository root, after the lead's build has the command):
+Usage (from the repository root, after scripts/build.sh):
   scripts/benchmark_ba.py                 full run (renders cached)
   scripts/benchmark_ba.py --quick         fewer points, faster
 Options: --output DIR (default build/bench), --colmap, --render, --wait S

@@ -5,8 +5,8 @@ import os
 import struct
 import unittest
 
-from cli_util import (Database, TempDirTestCase, run_colmap,
-                      write_noise_image)
+from cli_util import (Database, TempDirTestCase, read_text_cameras,
+                      run_colmap, write_noise_image)
 
 # One camera of every new model, with the ids upstream COLMAP 4.1 and our
 # README use.
@@ -38,19 +38,6 @@ def write_text_model(path, cameras):
     with open(os.path.join(path, "points3D.txt"), "w") as f:
         track = " ".join(f"{camera_id} 0" for camera_id, *_ in cameras)
         f.write(f"1 0.5 0.25 3.0 128 64 32 0.5 {track}\n")
-
-
-def read_text_cameras(path):
-    cameras = {}
-    with open(os.path.join(path, "cameras.txt")) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            fields = line.split()
-            cameras[int(fields[0])] = (fields[1], int(fields[2]),
-                                       int(fields[3]),
-                                       [float(v) for v in fields[4:]])
-    return cameras
 
 
 def read_binary_cameras(path):

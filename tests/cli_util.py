@@ -52,6 +52,20 @@ def write_noise_image(path, width, height, seed, gray=True):
         f.write(bytes(pixels))
 
 
+def read_text_cameras(path):
+    """{camera_id: (model name, width, height, [params])} of PATH/cameras.txt."""
+    cameras = {}
+    with open(os.path.join(path, "cameras.txt")) as f:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            fields = line.split()
+            cameras[int(fields[0])] = (fields[1], int(fields[2]),
+                                       int(fields[3]),
+                                       [float(v) for v in fields[4:]])
+    return cameras
+
+
 class Database:
     """Read-only view of a COLMAP database."""
 

@@ -9,7 +9,7 @@ import struct
 import subprocess
 import unittest
 
-from cli_util import TempDirTestCase, run_colmap
+from cli_util import TempDirTestCase, read_text_cameras, run_colmap
 
 RENDER = os.environ.get("SPHERA_RENDER", "")
 
@@ -25,15 +25,7 @@ def read_text_model(path):
     """(cameras {id: (model, width, height, params)},
         images {id: (header fields, [(x, y, point3D_id)])},
         points {id: ((x, y, z), [(image_id, point2D_idx)])})."""
-    cameras = {}
-    with open(os.path.join(path, "cameras.txt")) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            fields = line.split()
-            cameras[int(fields[0])] = (fields[1], int(fields[2]),
-                                       int(fields[3]),
-                                       [float(v) for v in fields[4:]])
+    cameras = read_text_cameras(path)
     images = {}
     with open(os.path.join(path, "images.txt")) as f:
         lines = [l.rstrip("\n") for l in f if not l.startswith("#")]

@@ -7,7 +7,7 @@ import random
 import struct
 import zlib
 
-from cli_util import TempDirTestCase, run_colmap
+from cli_util import TempDirTestCase, read_text_cameras, run_colmap
 
 import unittest
 
@@ -108,15 +108,7 @@ def write_scene(root, num_points=60, seed=4):
 def read_text_model(path):
     """cameras, images {name: (camera_id, [(x, y, point3D_id)])}, points
     {id: track length} of a text model."""
-    cameras = {}
-    with open(os.path.join(path, "cameras.txt")) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            fields = line.split()
-            cameras[int(fields[0])] = (fields[1], int(fields[2]),
-                                       int(fields[3]),
-                                       [float(v) for v in fields[4:]])
+    cameras = read_text_cameras(path)
     images = {}
     with open(os.path.join(path, "images.txt")) as f:
         lines = [l for l in f if not l.startswith("#")]
