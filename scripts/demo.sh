@@ -28,8 +28,16 @@ fi
 "${REPO_ROOT}/scripts/setup.sh"
 "${REPO_ROOT}/scripts/build.sh"
 
+# Only a folder this script made (it leaves a marker) is ever replaced.
+if [ -d "${WORK_DIR}" ] && [ -n "$(ls -A "${WORK_DIR}")" ] \
+    && [ ! -f "${WORK_DIR}/.sphera-demo" ]; then
+  echo "demo: ${WORK_DIR} exists and was not made by this script; set" \
+       "SPHERA_DEMO_DIR to a new folder" >&2
+  exit 1
+fi
 rm -rf "${WORK_DIR}"
 mkdir -p "${WORK_DIR}"
+touch "${WORK_DIR}/.sphera-demo"
 if [ -z "${image_dir}" ]; then
   echo "demo: rendering the default scene into ${WORK_DIR}/scene"
   "${RENDER}" --output "${WORK_DIR}/scene" --layout room9 \
