@@ -15,6 +15,8 @@ Data sets (rows):
   room9_equirect     9 equirectangular 2048x1024 cameras, room9 layout (SPHERA)
   room_fisheye190    12 UNIFIED_OMNI 190-degree fisheye 1024x1024 (SPHERA)
   room_hybrid        4 equirect + 4 fisheye + 4 PINHOLE 800x600 (SPHERA)
+  room_poles         9 equirectangular 2048x1024, alternately near floor and
+                     ceiling: many features near the poles (SPHERA)
   room_pinhole_ring  16 PINHOLE 640x480, ring layout (SPHERA and stock)
   fountain-P11       Strecha, 11 perspective 3072x2048 (SPHERA and stock)
   entry-P10          Strecha, 10 perspective 3072x2048 (SPHERA and stock)
@@ -57,6 +59,7 @@ DATASETS = [
     "room9_equirect",
     "room_fisheye190",
     "room_hybrid",
+    "room_poles",
     "room_pinhole_ring",
     "fountain-P11",
     "entry-P10",
@@ -383,6 +386,19 @@ def hybrid_rig():
     return lines
 
 
+def poles_rig():
+    """9 upright equirectangular cameras on the room9 grid, alternately 0.6 m
+    below the ceiling and 0.6 m above the floor, so that floor and ceiling
+    features are seen close to the poles of the panoramas."""
+    lines = []
+    for k in range(9):
+        centre = ((k % 3 - 1) * 0.8, -0.9 if k % 2 == 0 else 0.9,
+                  (k // 3 - 1) * 0.8)
+        lines.append(rig_line("pole%02d" % k, "EQUIRECTANGULAR", 2048, 1024,
+                              EQUIRECT_PARAMS, centre, 0))
+    return lines
+
+
 # Rendered sets: sphera_render arguments (a rig's lines, or layout options).
 RENDERED = {
     "room9_equirect": {"layout": ["--layout", "room9", "--model",
@@ -390,6 +406,7 @@ RENDERED = {
                                   "--height", "1024"]},
     "room_fisheye190": {"rig": fisheye190_rig},
     "room_hybrid": {"rig": hybrid_rig},
+    "room_poles": {"rig": poles_rig},
     "room_pinhole_ring": {"layout": ["--layout", "ring"]},
 }
 
@@ -494,10 +511,12 @@ class Benchmark:
 
     # -- pipeline ------------------------------------------------------------
 
-    def reconstruct(self, colmap, run_dir, image_path, groups, row):
-        """feature_extractor per camera group, exhaustive_matcher, mapper.
-        groups: [(model, params or None, image list or None)]. Fills the
-        times, num_models and returns the largest model's directory."""
+    def reconstruct(self, colmap, run_dir, image_path, groups, row,
+                    mapper_options=()):
+        """feature_extractor per camera group, exhaustive_matcher, mapper
+        (with extra `mapper_options`). groups: [(model, params or None, image
+        list or None)]. Fills the times, num_models and returns the largest
+        model's directory."""
         logs = os.path.join(run_dir, "logs")
         database = os.path.join(run_dir, "database.db")
         timeout = self.args.step_timeout
@@ -534,7 +553,7 @@ class Benchmark:
         seconds, _ = run_step("mapper",
                               [colmap, "mapper", "--database_path", database,
                                "--image_path", image_path, "--output_path",
-                               sparse], logs, timeout)
+                               sparse] + list(mapper_options), logs, timeout)
         row["t_map_s"] = round(seconds, 3)
         models = sparse_models(sparse)
         row["num_models"] = len(models)
@@ -840,7 +859,7 @@ def write_png(path, rows):
     return True
 
 
-def main():
+def make_parser():
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--only", default="",
@@ -865,6 +884,11 @@ def main():
     parser.add_argument("--fresh", action="store_true",
                         help="do not keep earlier rows in the CSV")
     parser.add_argument("--list", action="store_true", help="list the data sets")
+    return parser
+
+
+def main():
+    parser = make_parser()
     args = parser.parse_args()
 
     if args.list:
