@@ -1,0 +1,121 @@
+"""The mapper's per-image report: every image of the run is accounted for,
+registered in a model or named with the reason it is in none (no keypoints,
+no verified pair, no pose), a split into several models is pointed out, and a
+run that makes no model exits non-zero with the same report."""
+import os
+import re
+import subprocess
+import unittest
+
+from cli_util import Database, TempDirTestCase, run_colmap, write_noise_image
+
+RENDER = os.environ.get("SPHERA_RENDER", "")
+WIDTH, HEIGHT = 640, 480
+
+
+def write_blank_image(path):
+    with open(path, "wb") as f:
+        f.write(f"P5\n{WIDTH} {HEIGHT}\n255\n".encode())
+        f.write(bytes([128]) * (WIDTH * HEIGHT))
+
+
+class MapperReportTest(TempDirTestCase):
+    def extract_and_match(self, image_path):
+        database = self.path("database.db")
+        run_colmap("feature_extractor", "--database_path", database,
+                   "--image_path", image_path,
+                   "--ImageReader.camera_model", "PINHOLE",
+                   "--ImageReader.camera_params", "320,320,320,240",
+                   "--ImageReader.single_camera", "1",
+                   "--SiftExtraction.use_gpu", "0")
+        run_colmap("exhaustive_matcher", "--database_path", database,
+                   "--SiftMatching.use_gpu", "0")
+        return database
+
+    def run_mapper(self, database, image_path, output="sparse",
+                   min_model_size=5):
+        """min_model_size 5 keeps models of 6 images (the default, 10, drops
+        a second model smaller than that)."""
+        os.makedirs(self.path(output))
+        return run_colmap("mapper", "--database_path", database,
+                          "--image_path", image_path, "--output_path",
+                          self.path(output), "--Mapper.min_model_size",
+                          min_model_size, check=False)
+
+    def test_two_scenes_a_blank_and_a_noise_image(self):
+        images = self.path("images")
+        # Two arcs of the outward-looking ring that see opposite walls and
+        # share no view: two models.
+        scene = self.path("scene")
+        subprocess.run([RENDER, "--output", scene, "--layout", "ring",
+                        "--supersample", "2", "--seed", "3"],
+                       check=True, stdout=subprocess.DEVNULL)
+        names = sorted(os.listdir(os.path.join(scene, "images")))
+        self.assertEqual(len(names), 16)
+        os.makedirs(images)
+        for name in names[0:6] + names[8:14]:
+            os.symlink(os.path.join(scene, "images", name),
+                       os.path.join(images, name))
+        write_blank_image(os.path.join(images, "blank.pgm"))
+        write_noise_image(os.path.join(images, "noise.pgm"), WIDTH, HEIGHT,
+                          seed=5)
+        database = self.extract_and_match(images)
+        db = Database(database)
+        num_matches_before = db.scalar("SELECT COUNT(*) FROM matches")
+        db.close()
+
+        result = self.run_mapper(database, images)
+        log = result.stdout
+        self.assertEqual(result.returncode, 0, log[-3000:])
+        self.assertEqual(sorted(os.listdir(self.path("sparse"))), ["0", "1"])
+        summary = re.search(r"Mapper report: (\d+) of (\d+) images "
+                            r"registered, in (\d+) model\(s\)", log)
+        self.assertIsNotNone(summary, log[-3000:])
+        self.assertEqual(int(summary[2]), 14)
+        self.assertEqual(int(summary[3]), 2)
+        self.assertIn("The images split into 2 models", log)
+        models = [int(m) for m in re.findall(r"  model \d+: (\d+) images", log)]
+        self.assertEqual(len(models), 2)
+        self.assertEqual(sum(models), int(summary[1]))
+        self.assertRegex(log, r"blank\.pgm: not registered: no keypoints")
+        self.assertRegex(log, r"noise\.pgm: not registered: no verified "
+                              r"image pair with at least 15 inlier matches")
+        # Every image the report does not name as unregistered is in a model.
+        unregistered = re.findall(r"(\S+): not registered: ", log)
+        self.assertEqual(len(unregistered) + int(summary[1]), 14)
+        # With the default minimum model size the second arc's model is
+        # dropped: its images have verified pairs but are in no model.
+        result = self.run_mapper(database, images, "sparse_default", 10)
+        self.assertEqual(result.returncode, 0, result.stdout[-3000:])
+        self.assertEqual(os.listdir(self.path("sparse_default")), ["0"])
+        dropped = re.findall(r"(\S+): not registered: verified pairs with "
+                             r"\d+ image\(s\), but no model kept it",
+                             result.stdout)
+        self.assertEqual(len(dropped), 6, result.stdout[-3000:])
+        # The mapper only reads the database.
+        db = Database(database)
+        self.assertEqual(db.scalar("SELECT COUNT(*) FROM matches"),
+                         num_matches_before)
+        db.close()
+
+    def test_no_model_exits_non_zero_with_the_report(self):
+        images = self.path("images")
+        os.makedirs(images)
+        write_blank_image(os.path.join(images, "blank.pgm"))
+        for seed in (1, 2):
+            write_noise_image(os.path.join(images, f"noise{seed}.pgm"), WIDTH,
+                              HEIGHT, seed=seed)
+        database = self.extract_and_match(images)
+        result = self.run_mapper(database, images)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("Mapper report: 0 of 3 images registered, in 0 model(s)",
+                      result.stdout)
+        for name in ("blank.pgm", "noise1.pgm", "noise2.pgm"):
+            self.assertIn(f"{name}: not registered: ", result.stdout)
+        self.assertIn("failed to create sparse model", result.stdout)
+
+
+if __name__ == "__main__":
+    if not os.path.exists(RENDER):
+        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
+    unittest.main()
