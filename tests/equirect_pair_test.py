@@ -1,0 +1,56 @@
+"""Two-view geometry on rays for a real-format pair: the two rendered Sponza
+panoramas of the shared data set (../shared/data/equirect_pair, not in the
+repository: the test is skipped without it) are verified as a calibrated pair
+on the sphere and reconstructed by the mapper from that pair alone."""
+import os
+import re
+import unittest
+
+from cli_util import (SHARED_DATA, Database, TempDirTestCase, main_with_skip,
+                      run_colmap)
+
+IMAGES = os.path.join(SHARED_DATA, "equirect_pair")
+
+
+class EquirectPairTest(TempDirTestCase):
+    def test_pair_is_verified_on_the_sphere_and_reconstructed(self):
+        database_path = self.path("database.db")
+        run_colmap("feature_extractor", "--database_path", database_path,
+                   "--image_path", IMAGES,
+                   "--ImageReader.camera_model", "EQUIRECTANGULAR",
+                   "--ImageReader.single_camera", "1",
+                   "--SiftExtraction.use_gpu", "0")
+        run_colmap("exhaustive_matcher", "--database_path", database_path,
+                   "--SiftMatching.use_gpu", "0")
+        database = Database(database_path)
+        self.assertEqual(len(database.images()), 2)
+        (camera,) = database.cameras().values()
+        self.assertEqual(camera, (17, 2048, 1024, [2048.0, 1024.0]))
+        config, num_inliers = database.connection.execute(
+            "SELECT config, rows FROM two_view_geometries").fetchone()
+        num_matches = database.scalar("SELECT rows FROM matches")
+        database.close()
+        # Calibrated (essential matrix on rays), most matches kept.
+        self.assertEqual(config, 2)
+        self.assertGreater(num_inliers, 300)
+        self.assertGreater(num_inliers, 0.5 * num_matches)
+
+        os.makedirs(self.path("sparse"))
+        run_colmap("mapper", "--database_path", database_path,
+                   "--image_path", IMAGES, "--output_path", self.path("sparse"))
+        analysis = run_colmap("model_analyzer", "--path",
+                              self.path("sparse", "0")).stdout
+        registered = int(re.search(r"Registered images: (\d+)", analysis)[1])
+        points = int(re.search(r"Points: (\d+)", analysis)[1])
+        reprojection_px = float(
+            re.search(r"Mean reprojection error: ([0-9.]+)px", analysis)[1])
+        print(f"equirect_pair: {num_inliers}/{num_matches} inlier matches, "
+              f"{points} points, mean reprojection error "
+              f"{reprojection_px:.3f} px")
+        self.assertEqual(registered, 2)
+        self.assertGreater(points, 0.5 * num_inliers)
+        self.assertLess(reprojection_px, 1.0)
+
+
+if __name__ == "__main__":
+    main_with_skip([IMAGES])
