@@ -9,7 +9,7 @@ import struct
 import subprocess
 import unittest
 
-from cli_util import TempDirTestCase, read_text_cameras, run_colmap
+from cli_util import TempDirTestCase, read_text_model, run_colmap
 
 RENDER = os.environ.get("SPHERA_RENDER", "")
 
@@ -19,34 +19,6 @@ MAX_IMAGE_ID = 2147483647
 
 def pair_id(image_id1, image_id2):
     return image_id1 * MAX_IMAGE_ID + image_id2
-
-
-def read_text_model(path):
-    """(cameras {id: (model, width, height, params)},
-        images {id: (header fields, [(x, y, point3D_id)])},
-        points {id: ((x, y, z), [(image_id, point2D_idx)])})."""
-    cameras = read_text_cameras(path)
-    images = {}
-    with open(os.path.join(path, "images.txt")) as f:
-        lines = [l.rstrip("\n") for l in f if not l.startswith("#")]
-    for header, points in zip(lines[0::2], lines[1::2]):
-        fields = header.split()
-        values = points.split()
-        observations = [(float(values[i]), float(values[i + 1]),
-                         int(values[i + 2]))
-                        for i in range(0, len(values), 3)]
-        images[int(fields[0])] = (fields, observations)
-    points = {}
-    with open(os.path.join(path, "points3D.txt")) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            fields = line.split()
-            track = [(int(fields[i]), int(fields[i + 1]))
-                     for i in range(8, len(fields), 2)]
-            points[int(fields[0])] = (tuple(float(v) for v in fields[1:4]),
-                                      track)
-    return cameras, images, points
 
 
 def write_database(path, cameras, images, points):
