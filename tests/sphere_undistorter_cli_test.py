@@ -7,7 +7,8 @@ import random
 import struct
 import zlib
 
-from cli_util import TempDirTestCase, read_text_cameras, run_colmap
+import cli_util
+from cli_util import TempDirTestCase, run_colmap
 
 import unittest
 
@@ -108,25 +109,11 @@ def write_scene(root, num_points=60, seed=4):
 def read_text_model(path):
     """cameras, images {name: (camera_id, [(x, y, point3D_id)])}, points
     {id: track length} of a text model."""
-    cameras = read_text_cameras(path)
-    images = {}
-    with open(os.path.join(path, "images.txt")) as f:
-        lines = [l for l in f if not l.startswith("#")]
-    for header, points in zip(lines[0::2], lines[1::2]):
-        fields = header.split()
-        values = points.split()
-        observations = [(float(values[i]), float(values[i + 1]),
-                         int(values[i + 2]))
-                        for i in range(0, len(values), 3)]
-        images[fields[9]] = (int(fields[8]), observations)
-    points = {}
-    with open(os.path.join(path, "points3D.txt")) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            fields = line.split()
-            points[int(fields[0])] = (len(fields) - 8) // 2
-    return cameras, images, points
+    cameras, images, points = cli_util.read_text_model(path)
+    return (cameras,
+            {fields[9]: (int(fields[8]), observations)
+             for fields, observations in images.values()},
+            {point_id: len(track) for point_id, (_, track) in points.items()})
 
 
 def listing(root):
