@@ -16,73 +16,11 @@
 #include <iostream>
 #include <map>
 #include <sstream>
-#include <type_traits>
 
 #include <ceres/ceres.h>
 
 namespace colmap {
 namespace {
-
-template <typename M, typename = void>
-struct IsSphereCameraModel : std::false_type {};
-template <typename M>
-struct IsSphereCameraModel<M, std::void_t<typename M::sphere_model>>
-    : std::true_type {};
-
-// Pixel reprojection residual x_pred - x_obs for every camera model:
-//   x_pred = ImageFromRay(params, R X + t) for the sphere models (any ray in
-//   the field of view), ImgFromCam(params, R X + t) for COLMAP's own models.
-// EQUIRECTANGULAR (params w, h): the x residual is wrapped into [-w/2, w/2]
-// so that a point seen across the seam is not 2 pi away. The wrap offset is
-// an integer multiple of w taken from the value (not differentiated). A
-// point outside the field of view makes the evaluation fail (Ceres rejects
-// the step).
-template <typename CameraModel>
-class PixelReprojErrorCostFunction {
- public:
-  explicit PixelReprojErrorCostFunction(const Eigen::Vector2d& point2D)
-      : observed_(point2D) {}
-
-  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D) {
-    return new ceres::AutoDiffCostFunction<PixelReprojErrorCostFunction, 2, 4,
-                                           3, 3, CameraModel::num_params>(
-        new PixelReprojErrorCostFunction(point2D));
-  }
-
-  template <typename T>
-  bool operator()(const T* const cam_from_world_rotation,
-                  const T* const cam_from_world_translation,
-                  const T* const point3D, const T* const camera_params,
-                  T* residuals) const {
-    const Eigen::Matrix<T, 3, 1> v =
-        EigenQuaternionMap<T>(cam_from_world_rotation) *
-            EigenVector3Map<T>(point3D) +
-        EigenVector3Map<T>(cam_from_world_translation);
-    T pixel[2];
-    if constexpr (IsSphereCameraModel<CameraModel>::value) {
-      if (!CameraModel::sphere_model::ImageFromRay(camera_params, v.data(),
-                                                   pixel)) {
-        return false;
-      }
-    } else {
-      if (!(v[2] > T(0))) return false;
-      CameraModel::ImgFromCam(camera_params, v[0], v[1], v[2], &pixel[0],
-                              &pixel[1]);
-    }
-    residuals[0] = pixel[0] - T(observed_(0));
-    residuals[1] = pixel[1] - T(observed_(1));
-    if (CameraModel::model_id == CameraModelId::kEquirectangular) {
-      const double w = sphera::internal::ScalarPart(camera_params[0]);
-      const double k =
-          std::round(sphera::internal::ScalarPart(residuals[0]) / w);
-      residuals[0] -= T(k * w);
-    }
-    return true;
-  }
-
- private:
-  const Eigen::Vector2d observed_;
-};
 
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() -
