@@ -5,9 +5,14 @@ seen by 9 equirectangular cameras, and a hybrid set of equirectangular,
 import json
 import os
 import subprocess
+import sys
 import unittest
 
 from cli_util import TempDirTestCase, run_colmap
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                "..", "scripts"))
+from benchmark_sfm import hybrid_rig  # noqa: E402  (the benchmark's rig)
 
 RENDER = os.environ.get("SPHERA_RENDER", "")
 
@@ -51,6 +56,10 @@ class RenderedSfMTest(TempDirTestCase):
                    self.path("sparse"))
         models = sorted(os.listdir(self.path("sparse")))
         self.assertEqual(models, ["0"], "the images split into several models")
+        os.makedirs(self.path("sparse_txt"))
+        run_colmap("model_converter", "--input_path", self.path("sparse", "0"),
+                   "--output_path", self.path("sparse_txt"), "--output_type",
+                   "TXT")
         os.makedirs(self.path("eval"))
         run_colmap("model_evaluator", "--gt_path",
                    os.path.join(scene, "sparse_gt"), "--input_path",
@@ -90,6 +99,30 @@ class RenderedSfMTest(TempDirTestCase):
         self.assertGreaterEqual(result["num_points3D"], 5000)
         self.assertLess(result["mean_angular_error_px"], 1.0)
         self.assertLess(result["median_point_error"], 0.01)
+
+    def test_hybrid_set_keeps_equirectangular_size(self):
+        # 4 panoramas, 4 fisheye 190 degrees, 4 pinhole (the SfM benchmark's
+        # room_hybrid rig), with the mapper's default intrinsics refinement.
+        rig = self.path("hybrid_rig.txt")
+        with open(rig, "w") as f:
+            f.write("\n".join(hybrid_rig()) + "\n")
+        scene = self.path("hybrid")
+        render(scene, "--rig", rig, "--supersample", 2)
+        result = self.reconstruct(scene, self.gt_image_lists(scene))
+        print(json.dumps({k: v for k, v in result.items()
+                          if k not in ("images", "cameras")}, indent=1))
+        self.assertEqual(result["num_registered"], 12)
+        # Registration must not refine the panoramas' w, h (their image
+        # size); when it did, the panoramas were off by up to 0.2 degrees.
+        cameras = read_cameras(self.path("sparse_txt"))
+        equirect = [params for model, params in cameras.values()
+                    if model == "EQUIRECTANGULAR"]
+        self.assertEqual(equirect, [["2048", "1024"]])
+        # Measured here: mean 0.017, max 0.076 degrees (with the w, h drift:
+        # mean 0.06, max 0.2).
+        self.assertLess(result["mean_rotation_error_deg"], 0.03)
+        self.assertLess(result["max_rotation_error_deg"], 0.15)
+        self.assertLess(result["mean_position_error"], 0.001)  # metres
 
     def test_perspective_ring_keeps_colmap_behaviour(self):
         # Perspective-only data runs COLMAP's own estimators.
