@@ -1,6 +1,7 @@
 """Helpers for the integration tests that drive the built `colmap` program."""
 import os
 import random
+import re
 import shutil
 import sqlite3
 import struct
@@ -29,6 +30,17 @@ def run_colmap(*args, check=True, timeout=1800):
         raise AssertionError(f"colmap {' '.join(map(str, args))} exited "
                              f"{result.returncode}:\n{result.stdout[-4000:]}")
     return result
+
+
+def analyze_model(model_path):
+    """(registered images, points, mean reprojection error in px) that
+    `colmap model_analyzer` reports for a model."""
+    analysis = run_colmap("model_analyzer", "--path", model_path).stdout
+    registered = int(re.search(r"Registered images: (\d+)", analysis)[1])
+    points = int(re.search(r"Points: (\d+)", analysis)[1])
+    reprojection_px = float(
+        re.search(r"Mean reprojection error: ([0-9.]+)px", analysis)[1])
+    return registered, points, reprojection_px
 
 
 def write_noise_image(path, width, height, seed, gray=True):

@@ -2,11 +2,10 @@
 Theta S panoramas of the shared data set (../shared/data/equirect_flat/images, not in
 the repository: the test is skipped without it)."""
 import os
-import re
 import unittest
 
-from cli_util import (SHARED_DATA, Database, TempDirTestCase, main_with_skip,
-                      run_colmap)
+from cli_util import (SHARED_DATA, Database, TempDirTestCase, analyze_model,
+                      main_with_skip, run_colmap)
 
 IMAGES = os.path.join(SHARED_DATA, "equirect_flat", "images")
 
@@ -49,12 +48,8 @@ class EquirectFlatTest(TempDirTestCase):
         run_colmap("mapper", "--database_path", database_path,
                    "--image_path", IMAGES, "--output_path", self.path("sparse"))
         self.assertEqual(os.listdir(self.path("sparse")), ["0"])
-        analysis = run_colmap("model_analyzer", "--path",
-                              self.path("sparse", "0")).stdout
-        registered = int(re.search(r"Registered images: (\d+)", analysis)[1])
-        points = int(re.search(r"Points: (\d+)", analysis)[1])
-        reprojection_px = float(
-            re.search(r"Mean reprojection error: ([0-9.]+)px", analysis)[1])
+        registered, points, reprojection_px = analyze_model(
+            self.path("sparse", "0"))
         print(f"equirect_flat: {registered}/11 registered, {points} points, "
               f"mean reprojection error {reprojection_px:.3f} px")
         self.assertEqual(registered, 11)

@@ -3,11 +3,10 @@ panoramas of the shared data set (../shared/data/equirect_pair, not in the
 repository: the test is skipped without it) are verified as a calibrated pair
 on the sphere and reconstructed by the mapper from that pair alone."""
 import os
-import re
 import unittest
 
-from cli_util import (SHARED_DATA, Database, TempDirTestCase, main_with_skip,
-                      run_colmap)
+from cli_util import (SHARED_DATA, Database, TempDirTestCase, analyze_model,
+                      main_with_skip, run_colmap)
 
 IMAGES = os.path.join(SHARED_DATA, "equirect_pair")
 
@@ -38,12 +37,8 @@ class EquirectPairTest(TempDirTestCase):
         os.makedirs(self.path("sparse"))
         run_colmap("mapper", "--database_path", database_path,
                    "--image_path", IMAGES, "--output_path", self.path("sparse"))
-        analysis = run_colmap("model_analyzer", "--path",
-                              self.path("sparse", "0")).stdout
-        registered = int(re.search(r"Registered images: (\d+)", analysis)[1])
-        points = int(re.search(r"Points: (\d+)", analysis)[1])
-        reprojection_px = float(
-            re.search(r"Mean reprojection error: ([0-9.]+)px", analysis)[1])
+        registered, points, reprojection_px = analyze_model(
+            self.path("sparse", "0"))
         print(f"equirect_pair: {num_inliers}/{num_matches} inlier matches, "
               f"{points} points, mean reprojection error "
               f"{reprojection_px:.3f} px")
