@@ -1,5 +1,7 @@
 #include "colmap_ext/exe/sphere_bundle_adjuster.h"
 
+#include "colmap_ext/sensor/camera_params_held.h"
+
 #include "colmap/controllers/option_manager.h"
 #include "colmap/estimators/bundle_adjustment.h"
 #include "colmap/estimators/cost_functions.h"
@@ -34,23 +36,14 @@ std::vector<image_t> SortedRegImageIds(const Reconstruction& reconstruction) {
   return ids;
 }
 
-// Parameters held constant when intrinsics are refined: principal point
-// (as COLMAP's default) and the model's fixed parameters.
-std::vector<int> ConstantCameraParams(const Camera& camera) {
-  std::vector<int> idxs;
-  for (const size_t idx : camera.PrincipalPointIdxs()) idxs.push_back(idx);
-  for (const size_t idx : CameraModelFixedParamsIdxs(camera.model_id)) {
-    idxs.push_back(static_cast<int>(idx));
-  }
-  std::sort(idxs.begin(), idxs.end());
-  idxs.erase(std::unique(idxs.begin(), idxs.end()), idxs.end());
-  return idxs;
-}
-
 void ParameterizeCamera(ceres::Problem* problem, Camera* camera,
                         bool refine) {
   if (!problem->HasParameterBlock(camera->params.data())) return;
-  const std::vector<int> constant = ConstantCameraParams(*camera);
+  // When intrinsics are refined: all but the principal point (held, as
+  // COLMAP's default) and the model's fixed parameters.
+  const std::vector<int> constant = CameraParamsHeldConstant(
+      *camera, /*refine_focal_length=*/true, /*refine_principal_point=*/false,
+      /*refine_extra_params=*/true);
   if (!refine || constant.size() == camera->params.size()) {
     problem->SetParameterBlockConstant(camera->params.data());
   } else if (!constant.empty()) {
