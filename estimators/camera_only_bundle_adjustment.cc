@@ -104,9 +104,12 @@ std::string Fmt(const char* fmt, double v) {
   return buf;
 }
 
-// Per-image tau [rad] for this iteration, or an error message.
+// Per-image tau [rad] for this iteration, or an error message (and the
+// image it concerns, or -1).
 bool EvaluateTau(const CameraOnlyBAOptions& options, int num_images,
-                 std::vector<double>* tau, std::string* message) {
+                 std::vector<double>* tau, std::string* message,
+                 int* image_idx) {
+  *image_idx = -1;
   tau->assign(num_images, 0);
   for (int i = 0; i < num_images; ++i) {
     double t;
@@ -123,8 +126,8 @@ bool EvaluateTau(const CameraOnlyBAOptions& options, int num_images,
       return false;
     }
     if (!(t > 0) || !std::isfinite(t)) {
-      *message = "tau_rad of image " + std::to_string(i) +
-                 " must be finite and > 0, got " + Fmt("%g", t);
+      *message = "tau_rad must be finite and > 0, got " + Fmt("%g", t);
+      *image_idx = i;
       return false;
     }
     (*tau)[i] = t;
@@ -243,9 +246,11 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
   const auto t_start = std::chrono::steady_clock::now();
   CameraOnlyBAResult result;
   result.poses = problem.poses;
-  auto finish = [&](CameraOnlyBAStatus status, const std::string& message) {
+  auto finish = [&](CameraOnlyBAStatus status, const std::string& message,
+                    int image_idx = -1) {
     result.status = status;
     result.message = message;
+    result.image_idx = image_idx;
     result.elapsed_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() -
                                       t_start)
@@ -298,18 +303,19 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
   }
   std::vector<double> tau;
   std::string tau_message;
-  if (!EvaluateTau(options, num_images, &tau, &tau_message)) {
-    return finish(CameraOnlyBAStatus::kInvalidInput, tau_message);
+  int tau_image = -1;
+  if (!EvaluateTau(options, num_images, &tau, &tau_message, &tau_image)) {
+    return finish(CameraOnlyBAStatus::kInvalidInput, tau_message, tau_image);
   }
   for (int i = 0; i < num_images; ++i) {
     if (num_obs_per_image[i] < options.min_observations_per_image) {
       return finish(
           CameraOnlyBAStatus::kTooFewObservations,
-          "image " + std::to_string(i) + " observes only " +
-              std::to_string(num_obs_per_image[i]) +
+          "observes only " + std::to_string(num_obs_per_image[i]) +
               " points of tracks with >= 2 observations "
               "(min_observations_per_image = " +
-              std::to_string(options.min_observations_per_image) + ")");
+              std::to_string(options.min_observations_per_image) + ")",
+          i);
     }
   }
   const bool fix_gauge = options.gauge == GaugeFixing::kFirstTwoCameras;
@@ -336,8 +342,9 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
 
   // ---- Outer iterations ------------------------------------------------
   for (int iter = 1; iter <= options.max_iterations; ++iter) {
-    if (!EvaluateTau(options, num_images, &tau, &tau_message)) {
-      return finish(CameraOnlyBAStatus::kInvalidInput, tau_message);
+    if (!EvaluateTau(options, num_images, &tau, &tau_message, &tau_image)) {
+      return finish(CameraOnlyBAStatus::kInvalidInput, tau_message,
+                    tau_image);
     }
     int num_triangulated = 0;
     std::vector<ReliablePoint> points = TriangulateReliablePoints(
@@ -375,12 +382,12 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
           options.min_observations_per_image) {
         return finish(
             CameraOnlyBAStatus::kTooFewObservations,
-            "image " + std::to_string(i) + " keeps only " +
-                std::to_string(refs[i].size()) +
+            "keeps only " + std::to_string(refs[i].size()) +
                 " reliable observations within tau (" +
                 Fmt("%.3g", tau[i]) + " rad; min_observations_per_image = " +
                 std::to_string(options.min_observations_per_image) +
-                "); increase tau");
+                "); increase tau",
+            i);
       }
       std::vector<Eigen::Vector3d> rays, X;
       for (const auto& ref : refs[i]) {
@@ -578,8 +585,8 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
   }
 
   // ---- Final re-triangulation from the refined poses -------------------
-  if (!EvaluateTau(options, num_images, &tau, &tau_message)) {
-    return finish(CameraOnlyBAStatus::kInvalidInput, tau_message);
+  if (!EvaluateTau(options, num_images, &tau, &tau_message, &tau_image)) {
+    return finish(CameraOnlyBAStatus::kInvalidInput, tau_message, tau_image);
   }
   result.points =
       TriangulateReliablePoints(poses, tracks, tau, options.refine_points,

@@ -184,6 +184,9 @@ struct CameraOnlyBAIterationStats {
 struct CameraOnlyBAResult {
   CameraOnlyBAStatus status = CameraOnlyBAStatus::kInvalidInput;
   std::string message;
+  // The image (index into the problem's poses) that a failure concerns, or
+  // -1; the message does not repeat it, so the caller can name the image.
+  int image_idx = -1;
   std::vector<CameraPose> poses;          // refined (input poses on failure)
   std::vector<ReliablePoint> points;      // reliable points at the final poses
   std::vector<CameraOnlyBAIterationStats> iterations;

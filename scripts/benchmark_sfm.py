@@ -1,39 +1,82 @@
 #!/usr/bin/python3
-"""SfM benchmark of SPHERA (and stock COLMAP 3.10 where it applies).
+"""SfM benchmark of SPHERA against unpatched COLMAP of the same base.
 
 Runs the COLMAP command-line pipeline (feature_extractor, exhaustive_matcher,
-mapper) on each data set, evaluates the largest model against the ground
-truth with `colmap model_evaluator`, and writes a table, a CSV and a PNG.
+mapper) on each data set with SPHERA and with the reference system (stock
+COLMAP 3.10, or upstream COLMAP 4.x with --base 4), evaluates the largest
+model against the ground truth with SPHERA's `colmap model_evaluator`, and
+writes a table, two CSVs and a PNG.
 
 Usage (from the repository root):
   scripts/benchmark_sfm.py                      all data sets, SPHERA and stock
   scripts/benchmark_sfm.py --only room9_equirect,fountain-P11
   scripts/benchmark_sfm.py --quick --no_stock   smaller renders, SPHERA only
+  scripts/benchmark_sfm.py --quick --repeats 3  median and spread of 3 runs
+  scripts/benchmark_sfm.py --base 4 --quick     SPHERA on 4.x vs upstream 4.x
+  scripts/benchmark_sfm.py --mapper_options "--Mapper.ba_sphere_residual PIXEL"
+                           --label pixel --no_stock   a second SPHERA setup,
+                                                      added to the same CSV
   scripts/benchmark_sfm.py --list               the data sets
 
 Data sets (rows):
-  room9_equirect     9 equirectangular 2048x1024 cameras, room9 layout (SPHERA)
-  room_fisheye190    12 UNIFIED_OMNI 190-degree fisheye 1024x1024 (SPHERA)
-  room_hybrid        4 equirect + 4 fisheye + 4 PINHOLE 800x600 (SPHERA)
+  room9_equirect     9 equirectangular 2048x1024 cameras, room9 layout
+  room_fisheye190    12 UNIFIED_OMNI 190-degree fisheye 1024x1024
+  room_hybrid        4 equirect + 4 fisheye + 4 PINHOLE 800x600
   room_poles         9 equirectangular 2048x1024, alternately near floor and
-                     ceiling: many features near the poles (SPHERA)
-  room_pinhole_ring  16 PINHOLE 640x480, ring layout (SPHERA and stock)
-  fountain-P11       Strecha, 11 perspective 3072x2048 (SPHERA and stock)
-  entry-P10          Strecha, 10 perspective 3072x2048 (SPHERA and stock)
-  equirect_flat      11 real Ricoh Theta 5376x2688, no ground truth (SPHERA)
+                     ceiling: many features near the poles
+  room_pinhole_ring  16 PINHOLE 640x480, ring layout
+  fountain-P11       Strecha, 11 perspective 3072x2048
+  entry-P10          Strecha, 10 perspective 3072x2048
+  equirect_flat      11 real Ricoh Theta 5376x2688, no ground truth
+
+Bases (--base):
+  3.10 (default)  SPHERA build/bin/colmap, build/synthetic/sphera_render,
+                  output build/bench. Reference "stock": unpatched COLMAP 3.10
+                  (--stock_colmap, default build-stock/bin/colmap, built with
+                  scripts/build_stock.sh when missing, about 25 minutes). It
+                  knows PINHOLE only among these models, so it runs on the
+                  perspective sets (room_pinhole_ring, fountain-P11,
+                  entry-P10); the other sets have no stock row.
+  4               SPHERA build-4/bin/colmap, build-4/synthetic/sphera_render,
+                  output build-4/bench. Reference "upstream": unpatched
+                  upstream COLMAP 4.x at the same commit (--upstream_colmap,
+                  default ~/.cache/sphera-peers/colmap4/build/src/colmap/exe/
+                  colmap, built with ../shared/peers/build_colmap4.sh when
+                  missing, about 40 minutes). It knows EQUIRECTANGULAR and
+                  PINHOLE, so it runs on room9_equirect, room_poles,
+                  room_pinhole_ring, the Strecha sets and equirect_flat; the
+                  fisheye and hybrid sets get an upstream row "cannot: camera
+                  model UNIFIED_OMNI unknown to upstream". Command-line names
+                  of 4.x (--FeatureExtraction.*, --FeatureMatching.*).
+SPHERA's program always does the evaluation (model_evaluator,
+model_analyzer) and the Strecha import (strecha_importer), whichever system
+reconstructed. --no_stock (or --no_reference) leaves the reference out.
+
+Repeats: with --repeats N every (data set, system) is reconstructed N times
+from the same rendered scene (RANSAC differs run to run); the runs of SPHERA
+and of the reference alternate, so that load changes on the machine hit
+both. The table and sfm_results.csv give the median over the successful
+runs of every number, and for the rotation and position errors and the
+extraction, matching, mapping and whole-pipeline (t_total_s = extract +
+match + map) times also the spread as min and max (columns <name>_min,
+<name>_max; table "median [min..max]"). Ratios SPHERA / reference
+(map_time_ratio, total_time_ratio, rot_err_ratio) are ratios of the
+medians. runs.csv has one row per single run.
+
+--mapper_options "..." adds options to SPHERA's mapper only (split like a
+shell command line); --label NAME names SPHERA's rows (default "sphera"), so
+that runs with different options land side by side in one CSV.
 
 Rendered scenes are cached in OUTPUT_DIR/scenes/<name> (OUTPUT_DIR/scenes/
 <name>_quick with --quick) and reused; delete a directory to re-render it.
-Each run works in OUTPUT_DIR/runs/<dataset>/<system>/ (database, sparse
-models, evaluation.json, logs/ with every command's output). Results go to
-OUTPUT_DIR/sfm_results.csv and OUTPUT_DIR/sfm_results.png; rows of earlier
-runs that this run did not redo are kept in the CSV unless --fresh.
-
-Stock COLMAP (build-stock/bin/colmap) is built with scripts/build_stock.sh
-when missing (about 25 minutes), unless --no_stock. Stock runs only on the
-perspective sets. Shared real data (../shared/data by default) may be absent:
-those rows are reported as skipped. A failing data set is recorded in the
-`status` column and does not stop the run.
+Each run works in OUTPUT_DIR/runs/<dataset>/<system>/ (<system>/run<k>/ with
+--repeats above 1: database, sparse models, evaluation.json, logs/ with
+every command's output). Results go to OUTPUT_DIR/sfm_results.csv (one row
+per data set and system), OUTPUT_DIR/runs.csv (one row per run) and
+OUTPUT_DIR/sfm_results.png; rows of earlier runs that this run did not redo
+are kept in both CSVs unless --fresh. Shared real data (../shared/data by
+default) may be absent: those rows are reported as skipped. A failing run
+is recorded in the `status` column and does not stop the benchmark.
 
 Needs Debian's python3 (python3-matplotlib for the PNG; without it the PNG
 is skipped with a note).
@@ -47,6 +90,7 @@ import json
 import math
 import os
 import re
+import shlex
 import shutil
 import struct
 import subprocess
@@ -55,26 +99,86 @@ import time
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
-DATASETS = [
-    "room9_equirect",
-    "room_fisheye190",
-    "room_hybrid",
-    "room_poles",
-    "room_pinhole_ring",
-    "fountain-P11",
-    "entry-P10",
-    "equirect_flat",
-]
-# Perspective sets: stock COLMAP runs too, and the SPHERA row gets ratios.
-STOCK_DATASETS = {"room_pinhole_ring", "fountain-P11", "entry-P10"}
+# Data sets and the camera models their images use.
+DATASET_MODELS = {
+    "room9_equirect": ["EQUIRECTANGULAR"],
+    "room_fisheye190": ["UNIFIED_OMNI"],
+    "room_hybrid": ["EQUIRECTANGULAR", "UNIFIED_OMNI", "PINHOLE"],
+    "room_poles": ["EQUIRECTANGULAR"],
+    "room_pinhole_ring": ["PINHOLE"],
+    "fountain-P11": ["PINHOLE"],
+    "entry-P10": ["PINHOLE"],
+    "equirect_flat": ["EQUIRECTANGULAR"],
+}
+DATASETS = list(DATASET_MODELS)
 
-COLUMNS = [
-    "dataset", "system", "status", "registered", "total", "num_models",
-    "points", "rot_err_mean_deg", "rot_err_max_deg", "pos_err_mean",
-    "pos_err_max", "pos_err_mean_norm", "reproj_px", "point_err_mean",
-    "point_err_median", "t_extract_s", "t_match_s", "t_map_s",
-    "map_time_ratio", "rot_err_ratio", "render", "timestamp",
+# The COLMAP base SPHERA is built on, and the unpatched reference of that
+# base. reference_models: the models the reference knows among those above;
+# cannot_rows: data sets with other models get an explicit "cannot" row of
+# the reference (3.10: left out, as the README's table has always done).
+BASES = {
+    "3.10": {
+        "build_dir": "build",
+        "build_hint": "scripts/build.sh",
+        "reference": "stock",
+        "reference_title": "stock COLMAP 3.10",
+        "reference_models": {"PINHOLE"},
+        "cannot_rows": False,
+        "reference_builder": os.path.join(REPO_ROOT, "scripts", "build_stock.sh"),
+        "reference_build_minutes": 25,
+        "extraction_gpu": "--SiftExtraction.use_gpu",
+        "matching_gpu": "--SiftMatching.use_gpu",
+    },
+    "4": {
+        "build_dir": "build-4",
+        "build_hint": "SPHERA_COLMAP_BASE=4 scripts/build.sh",
+        "reference": "upstream",
+        "reference_title": "upstream COLMAP 4.x",
+        "reference_models": {"PINHOLE", "EQUIRECTANGULAR"},
+        "cannot_rows": True,
+        "reference_builder": os.path.normpath(os.path.join(
+            REPO_ROOT, "..", "shared", "peers", "build_colmap4.sh")),
+        "reference_build_minutes": 40,
+        "extraction_gpu": "--FeatureExtraction.use_gpu",
+        "matching_gpu": "--FeatureMatching.use_gpu",
+    },
+}
+REFERENCE_SYSTEMS = {base["reference"] for base in BASES.values()}
+DEFAULT_LABEL = "sphera"
+UPSTREAM_COLMAP4 = os.path.join(os.path.expanduser("~"), ".cache", "sphera-peers",
+                                "colmap4", "build", "src", "colmap", "exe",
+                                "colmap")
+
+# Numbers of a run, summarised over the repeats by their median; SPREAD_KEYS
+# also get <key>_min and <key>_max columns (the spread).
+COUNT_KEYS = ["registered", "total", "num_models", "points"]
+METRIC_KEYS = COUNT_KEYS + [
+    "rot_err_mean_deg", "rot_err_max_deg", "pos_err_mean", "pos_err_max",
+    "pos_err_mean_norm", "reproj_px", "point_err_mean", "point_err_median",
+    "t_extract_s", "t_match_s", "t_map_s", "t_total_s",
 ]
+SPREAD_KEYS = ["rot_err_mean_deg", "pos_err_mean", "t_extract_s", "t_match_s",
+               "t_map_s", "t_total_s"]
+# (median compared, ratio column): SPHERA / reference of the same base.
+RATIOS = [("t_map_s", "map_time_ratio"), ("t_total_s", "total_time_ratio"),
+          ("rot_err_mean_deg", "rot_err_ratio")]
+
+
+def with_spread(keys):
+    """keys, each of SPREAD_KEYS followed by its _min and _max column."""
+    columns = []
+    for key in keys:
+        columns.append(key)
+        if key in SPREAD_KEYS:
+            columns += [key + "_min", key + "_max"]
+    return columns
+
+
+COLUMNS = (["dataset", "system", "base", "status", "runs", "runs_ok"]
+           + with_spread(METRIC_KEYS) + [ratio for _, ratio in RATIOS]
+           + ["mapper_options", "render", "timestamp"])
+RUN_COLUMNS = (["dataset", "system", "base", "repeat", "status"] + METRIC_KEYS
+               + ["mapper_options", "render", "timestamp", "run_dir"])
 
 RENDER_SEED = 1
 DEFAULT_STEP_TIMEOUT = 3 * 3600
@@ -107,6 +211,10 @@ def fmt(value, digits=3):
     if abs(value) >= 1:
         return "%.*f" % (max(digits - 1, 1), value)
     return "%.*g" % (digits, value)
+
+
+def now():
+    return datetime.datetime.now().isoformat(timespec="seconds")
 
 
 def to_float(value):
@@ -415,17 +523,35 @@ RENDERED = {
 # The benchmark
 
 
+def unknown_models(base, dataset):
+    """The camera models of `dataset` that the reference of `base` lacks."""
+    return [m for m in DATASET_MODELS[dataset]
+            if m not in base["reference_models"]]
+
+
 class Benchmark:
     def __init__(self, args):
+        """Programs and directories from the options; those left empty take
+        the defaults of args.base. Raises ValueError on --mapper_options
+        that do not split."""
         self.args = args
-        self.output_dir = os.path.abspath(args.output_dir)
-        self.colmap = os.path.abspath(args.colmap)
-        self.stock_colmap = os.path.abspath(args.stock_colmap)
-        self.render = os.path.abspath(args.render)
+        self.base = BASES[args.base]
+        build = os.path.join(REPO_ROOT, self.base["build_dir"])
+        self.output_dir = os.path.abspath(args.output_dir
+                                          or os.path.join(build, "bench"))
+        self.colmap = os.path.abspath(args.colmap
+                                      or os.path.join(build, "bin", "colmap"))
+        self.render = os.path.abspath(
+            args.render or os.path.join(build, "synthetic", "sphera_render"))
         self.data_dir = os.path.abspath(args.data_dir)
         self.supersample = 2 if args.quick else 3
-        self.stock_error = None  # set when the stock build failed
-        self.stock_checked = False
+        self.label = args.label
+        self.mapper_options = shlex.split(args.mapper_options)
+        self.reference = self.base["reference"]
+        self.reference_colmap = os.path.abspath(
+            args.stock_colmap if self.reference == "stock" else args.upstream_colmap)
+        self.reference_error = None  # set when the reference is unavailable
+        self.reference_checked = False
 
     # -- programs ----------------------------------------------------------
 
@@ -438,23 +564,43 @@ class Benchmark:
             time.sleep(min(60, max(1, deadline - time.monotonic())))
         return True
 
-    def ensure_stock(self):
-        if self.stock_checked:
-            return self.stock_error
-        self.stock_checked = True
-        if os.access(self.stock_colmap, os.X_OK):
+    def ensure_reference(self):
+        """None when the reference program is there (building it first when
+        missing), else why it is not."""
+        if self.reference_checked:
+            return self.reference_error
+        self.reference_checked = True
+        if os.access(self.reference_colmap, os.X_OK):
             return None
-        script = os.path.join(REPO_ROOT, "scripts", "build_stock.sh")
-        log("stock COLMAP missing: building it with %s (about 25 min)" % script)
+        title = self.base["reference_title"]
+        script = self.base["reference_builder"]
+        if not os.path.exists(script):
+            folder = os.path.dirname(script)
+            self.reference_error = "cannot build %s: %s" % (
+                title, ("%s is absent" % folder) if not os.path.isdir(folder)
+                else "no %s in %s" % (os.path.basename(script), folder))
+            return self.reference_error
+        log("%s missing (%s): building it with %s (about %d min)" %
+            (title, self.reference_colmap, script,
+             self.base["reference_build_minutes"]))
         try:
-            run_step("build_stock", [script], os.path.join(self.output_dir, "logs"),
-                     timeout=4 * 3600)
+            _, output = run_step("build_" + self.reference, [script],
+                                 os.path.join(self.output_dir, "logs"),
+                                 timeout=4 * 3600)
         except StepError as error:
-            self.stock_error = "stock build failed: %s" % error
-            return self.stock_error
-        if not os.access(self.stock_colmap, os.X_OK):
-            self.stock_error = "stock build did not produce " + self.stock_colmap
-        return self.stock_error
+            self.reference_error = "%s build failed: %s" % (self.reference, error)
+            return self.reference_error
+        # build_colmap4.sh prints the program's path on its last line.
+        lines = output.strip().splitlines()
+        built = lines[-1].strip() if lines else ""
+        if not os.access(self.reference_colmap, os.X_OK) and os.path.isabs(built) \
+                and os.access(built, os.X_OK):
+            log("using %s" % built)
+            self.reference_colmap = built
+        if not os.access(self.reference_colmap, os.X_OK):
+            self.reference_error = "%s build did not produce %s" % (
+                self.reference, self.reference_colmap)
+        return self.reference_error
 
     # -- scenes --------------------------------------------------------------
 
@@ -491,7 +637,7 @@ class Benchmark:
             return scene
         if not self.wait_for(self.render, "sphera_render"):
             raise StepError("sphera_render not found at %s (build with "
-                            "scripts/build.sh)" % self.render)
+                            "%s)" % (self.render, self.base["build_hint"]))
         shutil.rmtree(scene, ignore_errors=True)
         os.makedirs(os.path.dirname(scene), exist_ok=True)
         if rig_text is not None:
@@ -514,8 +660,9 @@ class Benchmark:
     def reconstruct(self, colmap, run_dir, image_path, groups, row,
                     mapper_options=()):
         """feature_extractor per camera group, exhaustive_matcher, mapper
-        (with extra `mapper_options`). groups: [(model, params or None, image
-        list or None)]. Fills the times, num_models and returns the largest
+        (with extra `mapper_options`) with the option names of the base.
+        groups: [(model, params or None, image list or None)]. Fills the
+        times (t_total_s: their sum), num_models and returns the largest
         model's directory."""
         logs = os.path.join(run_dir, "logs")
         database = os.path.join(run_dir, "database.db")
@@ -526,7 +673,7 @@ class Benchmark:
                        "--image_path", image_path,
                        "--ImageReader.camera_model", model,
                        "--ImageReader.single_camera_per_folder", "1",
-                       "--SiftExtraction.use_gpu", "0"]
+                       self.base["extraction_gpu"], "0"]
             if params:
                 command += ["--ImageReader.camera_params",
                             ",".join(str(p) for p in params)]
@@ -545,7 +692,7 @@ class Benchmark:
         row["t_extract_s"] = round(t_extract, 3)
         seconds, _ = run_step("exhaustive_matcher",
                               [colmap, "exhaustive_matcher", "--database_path",
-                               database, "--SiftMatching.use_gpu", "0"],
+                               database, self.base["matching_gpu"], "0"],
                               logs, timeout)
         row["t_match_s"] = round(seconds, 3)
         sparse = os.path.join(run_dir, "sparse")
@@ -555,6 +702,8 @@ class Benchmark:
                                "--image_path", image_path, "--output_path",
                                sparse] + list(mapper_options), logs, timeout)
         row["t_map_s"] = round(seconds, 3)
+        row["t_total_s"] = round(row["t_extract_s"] + row["t_match_s"] +
+                                 row["t_map_s"], 3)
         models = sparse_models(sparse)
         row["num_models"] = len(models)
         if not models:
@@ -588,8 +737,21 @@ class Benchmark:
             row["point_err_mean"] = e.get("mean_point_error")
             row["point_err_median"] = e.get("median_point_error")
 
-    def new_run_dir(self, dataset, system):
+    def analyze(self, run_dir, model, row):
+        """model_analyzer's mean reprojection error, for a set without
+        ground truth."""
+        _, output = run_step("model_analyzer",
+                             [self.colmap, "model_analyzer", "--path", model],
+                             os.path.join(run_dir, "logs"), self.args.step_timeout)
+        match = re.search(r"Mean reprojection error:\s*([0-9.eE+-]+)", output)
+        if match:
+            row["reproj_px"] = float(match.group(1))
+
+    def new_run_dir(self, dataset, system, repeat=None):
+        """An empty OUTPUT_DIR/runs/<dataset>/<system>[/run<repeat>]."""
         run_dir = os.path.join(self.output_dir, "runs", dataset, system)
+        if repeat is not None:
+            run_dir = os.path.join(run_dir, "run%d" % repeat)
         shutil.rmtree(run_dir, ignore_errors=True)
         os.makedirs(run_dir)
         return run_dir
@@ -663,24 +825,30 @@ class Benchmark:
                  self.args.step_timeout)
         return image_path, [("PINHOLE", params, None)], gt
 
-    def run_one(self, dataset, system):
-        row = {"dataset": dataset, "system": system, "status": "ok",
-               "timestamp": datetime.datetime.now().isoformat(timespec="seconds"),
+    def run_one(self, dataset, system, repeat=1):
+        """One reconstruction and evaluation of `dataset` by `system` (the
+        SPHERA label or the reference); returns the run's row."""
+        is_reference = system == self.reference
+        row = {"dataset": dataset, "system": system, "base": self.args.base,
+               "repeat": repeat, "status": "ok",
+               "mapper_options": "" if is_reference
+               else shlex.join(self.mapper_options),
+               "timestamp": now(),
                "render": ("ss%d" % self.supersample) if dataset in RENDERED else ""}
-        colmap = self.colmap if system == "sphera" else self.stock_colmap
+        colmap = self.reference_colmap if is_reference else self.colmap
+        mapper_options = () if is_reference else self.mapper_options
         try:
-            if system == "stock":
-                error = self.ensure_stock()
+            if is_reference:
+                error = self.ensure_reference()
                 if error:
                     raise StepError(error)
-            run_dir = self.new_run_dir(dataset, system)
+            run_dir = self.new_run_dir(dataset, system,
+                                       repeat if self.args.repeats > 1 else None)
+            row["run_dir"] = run_dir
+            gt = depth = None
             if dataset in RENDERED:
                 scene = self.ensure_scene(dataset)
                 image_path, groups, gt, depth = self.rendered_inputs(scene, run_dir)
-                row["total"] = len(read_text_images(os.path.join(gt, "images.txt")))
-                log("%s/%s: reconstructing" % (dataset, system))
-                model = self.reconstruct(colmap, run_dir, image_path, groups, row)
-                self.evaluate(run_dir, model, gt, depth, row)
             elif dataset in ("fountain-P11", "entry-P10"):
                 inputs = self.strecha_inputs(dataset, run_dir)
                 if inputs is None:
@@ -688,10 +856,6 @@ class Benchmark:
                         self.data_dir, "strecha", dataset)
                     return row
                 image_path, groups, gt = inputs
-                row["total"] = len(read_text_images(os.path.join(gt, "images.txt")))
-                log("%s/%s: reconstructing" % (dataset, system))
-                model = self.reconstruct(colmap, run_dir, image_path, groups, row)
-                self.evaluate(run_dir, model, gt, None, row)
             elif dataset == "equirect_flat":
                 image_path = os.path.join(self.data_dir, "equirect_flat", "images")
                 names = list_images(image_path) if os.path.isdir(image_path) else []
@@ -700,97 +864,208 @@ class Benchmark:
                     return row
                 row["total"] = len(names)
                 width, height = jpeg_size(os.path.join(image_path, names[0]))
-                log("%s/%s: reconstructing" % (dataset, system))
-                model = self.reconstruct(
-                    colmap, run_dir, image_path,
-                    [("EQUIRECTANGULAR", [width, height], None)], row)
-                _, output = run_step("model_analyzer",
-                                     [self.colmap, "model_analyzer", "--path", model],
-                                     os.path.join(run_dir, "logs"),
-                                     self.args.step_timeout)
-                match = re.search(r"Mean reprojection error:\s*([0-9.eE+-]+)", output)
-                if match:
-                    row["reproj_px"] = float(match.group(1))
-                row["status"] = "ok (no ground truth)"
+                groups = [("EQUIRECTANGULAR", [width, height], None)]
             else:
                 raise StepError("unknown data set")
+            if gt:
+                row["total"] = len(read_text_images(os.path.join(gt, "images.txt")))
+            log("%s/%s run %d: reconstructing" % (dataset, system, repeat))
+            model = self.reconstruct(colmap, run_dir, image_path, groups, row,
+                                     mapper_options)
+            if gt:
+                self.evaluate(run_dir, model, gt, depth, row)
+            else:
+                self.analyze(run_dir, model, row)
+                row["status"] = "ok (no ground truth)"
         except StepError as error:
             row["status"] = str(error)
         except Exception as error:  # keep going with the other data sets
             row["status"] = "%s: %s" % (type(error).__name__, error)
         return row
 
+    def run_dataset(self, dataset):
+        """Runs SPHERA and (where it applies) the reference args.repeats
+        times each, alternating between them; a system that failed before
+        its mapper ran (no data, no program, render or extraction failed) is
+        not run again. Returns (the rows of the single runs, one summary row
+        per system including the reference's "cannot" row)."""
+        systems = [self.label]
+        cannot = []
+        unknown = unknown_models(self.base, dataset)
+        if not self.args.no_stock and not unknown:
+            systems.append(self.reference)
+        elif not self.args.no_stock and self.base["cannot_rows"]:
+            cannot.append({
+                "dataset": dataset, "system": self.reference,
+                "base": self.args.base, "runs": 0, "runs_ok": 0,
+                "status": "cannot: camera model %s unknown to %s" %
+                          ("/".join(unknown), self.reference),
+                "timestamp": now()})
+        runs = {system: [] for system in systems}
+        for repeat in range(1, self.args.repeats + 1):
+            for system in systems:
+                done = runs[system]
+                if done and not is_ok(done[-1]) and "t_match_s" not in done[-1]:
+                    continue  # failed before the mapper: repeating cannot help
+                start = time.monotonic()
+                row = self.run_one(dataset, system, repeat)
+                log("%s/%s run %d/%d: %s (%.0f s)" % (
+                    dataset, system, repeat, self.args.repeats, row["status"],
+                    time.monotonic() - start))
+                done.append(row)
+        return ([row for system in systems for row in runs[system]],
+                [summarize(runs[system]) for system in systems] + cannot)
+
 
 # ---------------------------------------------------------------------------
 # Results
 
 
+def median(values):
+    values = sorted(values)
+    middle = len(values) // 2
+    if len(values) % 2:
+        return values[middle]
+    return (values[middle - 1] + values[middle]) / 2
+
+
+def is_ok(row):
+    return str(row.get("status", "")).startswith("ok")
+
+
+def summarize(runs):
+    """The row of one (data set, system) from its runs: the median of every
+    number over the successful runs, the min and max of SPREAD_KEYS, and a
+    status that names the failed runs."""
+    last = runs[-1]
+    summary = {key: last.get(key, "") for key in
+               ("dataset", "system", "base", "mapper_options", "render",
+                "timestamp")}
+    ok = [r for r in runs if is_ok(r)]
+    failed = [r for r in runs if not is_ok(r)]
+    summary["runs"], summary["runs_ok"] = len(runs), len(ok)
+    for key in METRIC_KEYS:
+        values = [v for v in (to_float(r.get(key)) for r in ok) if v is not None]
+        if not values:
+            continue
+        value = median(values)
+        summary[key] = int(value) if key in COUNT_KEYS and value.is_integer() else value
+        if key in SPREAD_KEYS:
+            summary[key + "_min"], summary[key + "_max"] = min(values), max(values)
+    if not failed:
+        summary["status"] = ok[0]["status"]
+    elif len(runs) == 1:
+        summary["status"] = failed[0]["status"]
+    else:
+        first = "run %d: %s" % (failed[0]["repeat"], failed[0]["status"])
+        summary["status"] = ("%s in %d of %d runs; %s" % (ok[0]["status"], len(ok),
+                                                        len(runs), first)
+                             if ok else "all %d runs failed; %s" % (len(runs), first))
+    return summary
+
+
+def row_key(row):
+    """(base, data set, system): rows of earlier runs without a base come
+    from the 3.10 base."""
+    return (row.get("base") or "3.10", row.get("dataset"), row.get("system"))
+
+
 def add_ratios(rows):
-    by_key = {(r["dataset"], r["system"]): r for r in rows}
+    """SPHERA / reference of the medians in RATIOS, between rows of the same
+    base and data set."""
+    references = {row_key(r)[:2]: r for r in rows
+                  if r.get("system") in REFERENCE_SYSTEMS}
     for row in rows:
-        row["map_time_ratio"] = ""
-        row["rot_err_ratio"] = ""
-    for row in rows:
-        if row["system"] != "sphera" or row["dataset"] not in STOCK_DATASETS:
-            continue
-        stock = by_key.get((row["dataset"], "stock"))
-        if not stock:
-            continue
-        for key, ratio_key in (("t_map_s", "map_time_ratio"),
-                               ("rot_err_mean_deg", "rot_err_ratio")):
-            a, b = to_float(row.get(key)), to_float(stock.get(key))
+        reference = None
+        if row.get("system") not in REFERENCE_SYSTEMS:
+            reference = references.get(row_key(row)[:2])
+        for key, ratio_key in RATIOS:
+            row[ratio_key] = ""
+            a = to_float(row.get(key))
+            b = to_float(reference.get(key)) if reference else None
             if a is not None and b:
                 row[ratio_key] = a / b
+
+
+def system_order(system):
+    """SPHERA's default label first, then other labels, references last."""
+    return (system in REFERENCE_SYSTEMS, system != DEFAULT_LABEL, system)
 
 
 def sort_rows(rows):
     order = {name: i for i, name in enumerate(DATASETS)}
     return sorted(rows, key=lambda r: (order.get(r["dataset"], 99), r["dataset"],
-                                       0 if r["system"] == "sphera" else 1))
+                                       system_order(r["system"]),
+                                       to_float(r.get("repeat")) or 0))
 
 
-def print_table(rows):
-    headers = ["dataset", "system", "reg", "models", "points", "rot mean/max",
-               "pos mean/max", "pos norm", "reproj px", "pt err mean/med",
-               "extract/match/map s", "map t ratio", "rot ratio", "status"]
-    table = [headers]
-    for r in rows:
-        reg = "-"
-        if r.get("registered") not in (None, ""):
-            reg = "%s/%s" % (fmt(r.get("registered")), fmt(r.get("total")))
-        table.append([
-            r["dataset"], r["system"], reg, fmt(r.get("num_models")),
-            fmt(r.get("points")),
-            "%s/%s" % (fmt(r.get("rot_err_mean_deg")), fmt(r.get("rot_err_max_deg"))),
-            "%s/%s" % (fmt(r.get("pos_err_mean")), fmt(r.get("pos_err_max"))),
-            fmt(r.get("pos_err_mean_norm")), fmt(r.get("reproj_px")),
-            "%s/%s" % (fmt(r.get("point_err_mean")), fmt(r.get("point_err_median"))),
-            "%s/%s/%s" % (fmt(r.get("t_extract_s"), 2), fmt(r.get("t_match_s"), 2),
-                          fmt(r.get("t_map_s"), 2)),
-            fmt(r.get("map_time_ratio")), fmt(r.get("rot_err_ratio")),
-            r.get("status", ""),
-        ])
-    widths = [max(len(str(line[i])) for line in table) for i in range(len(headers) - 1)]
+def spread_cell(row, key, digits=3):
+    """'median [min..max]' (just the median after a single good run)."""
+    text = fmt(row.get(key), digits)
+    low, high = to_float(row.get(key + "_min")), to_float(row.get(key + "_max"))
+    if low is not None and high is not None and (to_float(row.get("runs_ok")) or 0) > 1:
+        text += " [%s..%s]" % (fmt(low, digits), fmt(high, digits))
+    return text
+
+
+def pair_cell(row, first, second):
+    return "%s/%s" % (fmt(row.get(first)), fmt(row.get(second)))
+
+
+TABLE_COLUMNS = [  # (header, cell of a row)
+    ("dataset", lambda r: r["dataset"]),
+    ("system", lambda r: r["system"]),
+    ("runs", lambda r: pair_cell(r, "runs_ok", "runs") if to_float(r.get("runs")) else "-"),
+    ("reg", lambda r: pair_cell(r, "registered", "total")
+     if r.get("registered") not in (None, "") else "-"),
+    ("models", lambda r: fmt(r.get("num_models"))),
+    ("points", lambda r: fmt(r.get("points"))),
+    ("rot mean", lambda r: spread_cell(r, "rot_err_mean_deg")),
+    ("rot max", lambda r: fmt(r.get("rot_err_max_deg"))),
+    ("pos mean", lambda r: spread_cell(r, "pos_err_mean")),
+    ("pos max", lambda r: fmt(r.get("pos_err_max"))),
+    ("pos norm", lambda r: fmt(r.get("pos_err_mean_norm"))),
+    ("reproj px", lambda r: fmt(r.get("reproj_px"))),
+    ("pt err mean/med", lambda r: pair_cell(r, "point_err_mean", "point_err_median")),
+    ("extract s", lambda r: spread_cell(r, "t_extract_s", 2)),
+    ("match s", lambda r: spread_cell(r, "t_match_s", 2)),
+    ("map s", lambda r: spread_cell(r, "t_map_s", 2)),
+    ("total s", lambda r: spread_cell(r, "t_total_s", 2)),
+    ("map t ratio", lambda r: fmt(r.get("map_time_ratio"))),
+    ("total t ratio", lambda r: fmt(r.get("total_time_ratio"))),
+    ("rot ratio", lambda r: fmt(r.get("rot_err_ratio"))),
+    ("status", lambda r: r.get("status", "")),
+]
+
+
+def print_table(rows, reference):
+    table = [[header for header, _ in TABLE_COLUMNS]]
+    table += [[cell(r) for _, cell in TABLE_COLUMNS] for r in rows]
+    widths = [max(len(str(line[i])) for line in table)
+              for i in range(len(TABLE_COLUMNS) - 1)]
     for n, line in enumerate(table):
         print("  ".join(str(c).ljust(w) for c, w in zip(line[:-1], widths))
               + "  " + str(line[-1]))
         if n == 0:
             print("  ".join("-" * w for w in widths) + "  ------")
-    print("rot: rotation error (deg); pos: position error (m, after the "
-          "similarity alignment); pos norm: / closest GT camera baseline; "
-          "reproj: mean angular reprojection error in pixel equivalents "
-          "(equirect_flat: model_analyzer's pixels); pt err: 3D point error "
-          "(m) against the rendered depth; ratios: SPHERA / stock.")
+    print("runs: successful/attempted runs; every number is the median over "
+          "the successful runs, [a..b] their min..max (the spread). rot: "
+          "rotation error (deg); pos: position error (m, after the similarity "
+          "alignment); pos norm: / closest GT camera baseline; reproj: mean "
+          "angular reprojection error in pixel equivalents (equirect_flat: "
+          "model_analyzer's pixels); pt err: 3D point error (m) against the "
+          "rendered depth; total: extract+match+map; ratios: SPHERA / %s of "
+          "the medians." % reference)
 
 
-def write_csv(path, rows):
+def write_csv(path, rows, columns):
     tmp = path + ".tmp"
     with open(tmp, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS, extrasaction="ignore")
+        writer = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
         writer.writeheader()
         for row in rows:
             writer.writerow({k: ("" if row.get(k) is None else row.get(k))
-                             for k in COLUMNS})
+                             for k in columns})
     os.replace(tmp, path)
 
 
@@ -801,7 +1076,85 @@ def read_csv(path):
         return [dict(r) for r in csv.DictReader(f)]
 
 
+def merge_earlier(path, rows, fresh):
+    """`rows` and, unless `fresh`, the rows of the CSV at `path` for other
+    (base, data set, system); returns them sorted, and the number kept."""
+    done = {row_key(r) for r in rows}
+    kept = [] if fresh else [r for r in read_csv(path) if row_key(r) not in done]
+    return sort_rows(rows + kept), len(kept)
+
+
+def system_title(system):
+    for base in BASES.values():
+        if base["reference"] == system:
+            return base["reference_title"]
+    return "SPHERA" if system == DEFAULT_LABEL else "SPHERA " + system
+
+
+PNG_BARS = [  # (column, title, log scale when the values span 50x)
+    ("rot_err_mean_deg", "mean rotation error (deg)", True),
+    ("pos_err_mean", "mean position error (m)", True),
+    ("t_total_s", "extract+match+map time (s)", False),
+    None,  # the ratio panel
+    ("t_extract_s", "extraction time (s)", False),
+    ("t_match_s", "matching time (s)", False),
+    ("t_map_s", "mapping time (s)", False),
+]
+PNG_RATIOS = [("map_time_ratio", "mapping"),
+              ("total_time_ratio", "extract+match+map")]
+COLOURS = ["#1f77b4", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf"]
+REFERENCE_COLOUR = "#ff7f0e"
+
+
+def bar_value(row, key):
+    """(median, min, max) of `key` in `row` (min, max None without a
+    spread); None when the value is missing, False when there is no row."""
+    if row is None:
+        return False
+    value = to_float(row.get(key))
+    if value is None:
+        return None
+    return value, to_float(row.get(key + "_min")), to_float(row.get(key + "_max"))
+
+
+def draw_bars(ax, datasets, series, log_scale):
+    """Grouped bars, one group per data set. series: [(label, bar style,
+    [bar_value(...) per data set])]; None is marked n/a, False left empty;
+    min and max give the error bar."""
+    width = 0.8 / max(len(series), 1)
+    positives = []
+    for s_index, (label, style, values) in enumerate(series):
+        xs, ys, errors = [], [], [[], []]
+        for d_index, value in enumerate(values):
+            x = d_index + (s_index - (len(series) - 1) / 2) * width
+            if value is None:
+                ax.annotate("n/a", (x, 0), ha="center", va="bottom", fontsize=7,
+                            color=style["color"], rotation=90,
+                            xycoords=("data", "axes fraction"))
+            if not value:
+                continue
+            y, low, high = value
+            xs.append(x)
+            ys.append(y)
+            errors[0].append(y - low if low is not None else 0)
+            errors[1].append(high - y if high is not None else 0)
+            positives += [v for v in (y, low, high) if v is not None and v > 0]
+        has_spread = any(errors[0]) or any(errors[1])
+        bars = ax.bar(xs, ys, width, label=label, yerr=errors if has_spread else None,
+                      capsize=2, error_kw={"elinewidth": 0.8}, **style)
+        for bar, y, above in zip(bars, ys, errors[1]):
+            ax.annotate(fmt(y, 2), (bar.get_x() + bar.get_width() / 2, y + above),
+                        ha="center", va="bottom", fontsize=6)
+    if log_scale and positives and max(positives) / min(positives) > 50:
+        ax.set_yscale("log")
+    ax.set_xticks(range(len(datasets)))
+    ax.set_xticklabels(datasets, rotation=30, ha="right", fontsize=8)
+    ax.grid(axis="y", alpha=0.3)
+
+
 def write_png(path, rows):
+    """Error and time panels (median, min..max as error bars) for every
+    system, and a panel of the SPHERA / reference time ratios."""
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -811,50 +1164,61 @@ def write_png(path, rows):
         return False
     datasets = [d for d in DATASETS if any(r["dataset"] == d for r in rows)]
     datasets += sorted({r["dataset"] for r in rows} - set(datasets))
-    systems = [s for s in ("sphera", "stock") if any(r["system"] == s for r in rows)]
+    systems = sorted({r["system"] for r in rows}, key=system_order)
+    labels = [s for s in systems if s not in REFERENCE_SYSTEMS]
     by_key = {(r["dataset"], r["system"]): r for r in rows}
-    colours = {"sphera": "#1f77b4", "stock": "#ff7f0e"}
-    fig, axes = plt.subplots(1, 2, figsize=(max(10, 2.2 * len(datasets)), 4.8))
-    width = 0.8 / max(len(systems), 1)
-    panels = [("rot_err_mean_deg", "mean rotation error (deg)", True),
-              ("t_map_s", "mapping time (s)", False)]
-    for ax, (key, title, log_scale) in zip(axes, panels):
-        positives = []
-        for s_index, system in enumerate(systems):
-            xs, ys, missing = [], [], []
-            for d_index, dataset in enumerate(datasets):
-                x = d_index + (s_index - (len(systems) - 1) / 2) * width
-                row = by_key.get((dataset, system))
-                value = to_float(row.get(key)) if row else None
-                if value is None:
-                    if row is not None:
-                        missing.append(x)
-                    continue
-                xs.append(x)
-                ys.append(value)
-                if value > 0:
-                    positives.append(value)
-            bars = ax.bar(xs, ys, width, label="SPHERA" if system == "sphera"
-                          else "stock COLMAP 3.10", color=colours[system])
-            for bar, value in zip(bars, ys):
-                ax.annotate(fmt(value, 2), (bar.get_x() + bar.get_width() / 2,
-                                            bar.get_height()),
-                            ha="center", va="bottom", fontsize=7)
-            for x in missing:
-                ax.annotate("n/a", (x, 0), ha="center", va="bottom", fontsize=7,
-                            color=colours[system], rotation=90,
-                            xycoords=("data", "axes fraction"))
-        if log_scale and positives and max(positives) / min(positives) > 50:
-            ax.set_yscale("log")
-        ax.set_title(title)
-        ax.set_xticks(range(len(datasets)))
-        ax.set_xticklabels(datasets, rotation=30, ha="right", fontsize=8)
-        ax.grid(axis="y", alpha=0.3)
-        if systems:
-            ax.legend(fontsize=8)
-    fig.suptitle("SPHERA SfM benchmark")
+    colours = dict(zip(labels, COLOURS))
+    colours.update({s: REFERENCE_COLOUR for s in REFERENCE_SYSTEMS})
+
+    def series_of(system, key, label, style):
+        return (label, style, [bar_value(by_key.get((d, system)), key)
+                               for d in datasets])
+
+    panel_width = max(4.0, 0.6 * len(datasets))
+    fig, axes = plt.subplots(2, 4, figsize=(4 * panel_width, 9))
+    for ax, panel in zip(axes.flat, PNG_BARS):
+        if panel is not None:
+            key, title, log_scale = panel
+            draw_bars(ax, datasets,
+                      [series_of(s, key, system_title(s), {"color": colours.get(s)})
+                       for s in systems], log_scale)
+            ax.set_title(title)
+            continue
+        # Ratios: no bar (rather than n/a) where there is no reference.
+        series = []
+        for system in labels:
+            for (key, kind), hatch in zip(PNG_RATIOS, ("", "//")):
+                label, style, values = series_of(
+                    system, key, "%s: %s" % (system_title(system), kind),
+                    {"color": colours[system], "hatch": hatch,
+                     "edgecolor": "white"})
+                values = [v or False for v in values]
+                if any(values):
+                    series.append((label, style, values))
+        draw_bars(ax, datasets, series, False)
+        ax.axhline(1.0, color="black", linewidth=0.8)
+        ax.set_title("time SPHERA / reference (medians)")
+        if series:
+            ax.set_ylim(top=ax.get_ylim()[1] * 1.4)  # room for the legend
+            ax.legend(fontsize=7, loc="upper left")
+        else:
+            ax.text(0.5, 0.5, "no reference runs", ha="center",
+                    transform=ax.transAxes)
+    legend_ax = axes.flat[-1]
+    legend_ax.axis("off")
+    handles, names = axes.flat[0].get_legend_handles_labels()
+    if handles:
+        legend_ax.legend(handles, names, loc="upper left", fontsize=9)
+    runs = sorted({int(to_float(r.get("runs")) or 0) for r in rows} - {0})
+    legend_ax.text(0, 0.4, "bars: median over the successful runs\n"
+                   "(%s run(s) per system)\nerror bars: min..max\n"
+                   "n/a: no value (failed, skipped or cannot run)" %
+                   ("/".join(map(str, runs)) or "1"),
+                   fontsize=9, va="top", transform=legend_ax.transAxes)
+    bases = sorted({row_key(r)[0] for r in rows})
+    fig.suptitle("SPHERA SfM benchmark (COLMAP %s base)" % " and ".join(bases))
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=110)
     plt.close(fig)
     return True
 
@@ -862,27 +1226,43 @@ def write_png(path, rows):
 def make_parser():
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--base", choices=sorted(BASES), default="3.10",
+                        help="COLMAP base of SPHERA and of the reference "
+                             "(default %(default)s)")
     parser.add_argument("--only", default="",
                         help="comma-separated data sets (default: all)")
     parser.add_argument("--quick", action="store_true",
                         help="smaller renders (supersample 2, cached separately)")
-    parser.add_argument("--no_stock", action="store_true",
-                        help="no stock COLMAP runs (and no stock build)")
-    parser.add_argument("--output_dir", default=os.path.join(REPO_ROOT, "build", "bench"))
-    parser.add_argument("--colmap", default=os.path.join(REPO_ROOT, "build", "bin", "colmap"))
+    parser.add_argument("--repeats", type=int, default=1,
+                        help="runs per data set and system (default %(default)s)")
+    parser.add_argument("--no_stock", "--no_reference", dest="no_stock",
+                        action="store_true",
+                        help="no reference runs (stock or upstream; and no build)")
+    parser.add_argument("--mapper_options", default="",
+                        help="extra options of SPHERA's mapper (not the "
+                             "reference's), e.g. \"--Mapper.ba_sphere_residual PIXEL\"")
+    parser.add_argument("--label", default=DEFAULT_LABEL,
+                        help="system name of SPHERA's rows (default %(default)s)")
+    parser.add_argument("--output_dir", default=None,
+                        help="default: <build dir of the base>/bench")
+    parser.add_argument("--colmap", default=None,
+                        help="SPHERA's program (default: <build dir>/bin/colmap)")
+    parser.add_argument("--render", default=None,
+                        help="default: <build dir>/synthetic/sphera_render")
     parser.add_argument("--stock_colmap",
-                        default=os.path.join(REPO_ROOT, "build-stock", "bin", "colmap"))
-    parser.add_argument("--render", default=os.path.join(REPO_ROOT, "build", "synthetic",
-                                                         "sphera_render"))
+                        default=os.path.join(REPO_ROOT, "build-stock", "bin", "colmap"),
+                        help="reference of --base 3.10")
+    parser.add_argument("--upstream_colmap", default=UPSTREAM_COLMAP4,
+                        help="reference of --base 4 (default %(default)s)")
     parser.add_argument("--data_dir", default=os.path.join(REPO_ROOT, "..", "shared", "data"),
                         help="shared real data (strecha/, equirect_flat/)")
     parser.add_argument("--wait_minutes", type=float, default=0,
-                        help="wait up to this long for build/bin/colmap and "
+                        help="wait up to this long for SPHERA's colmap and "
                              "sphera_render to appear (polls every 60 s)")
     parser.add_argument("--step_timeout", type=int, default=DEFAULT_STEP_TIMEOUT,
                         help="seconds allowed per command (default %(default)s)")
     parser.add_argument("--fresh", action="store_true",
-                        help="do not keep earlier rows in the CSV")
+                        help="do not keep earlier rows in the CSVs")
     parser.add_argument("--list", action="store_true", help="list the data sets")
     return parser
 
@@ -890,11 +1270,23 @@ def make_parser():
 def main():
     parser = make_parser()
     args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error("--repeats must be at least 1")
+    if (not re.fullmatch(r"[A-Za-z0-9_.+-]+", args.label)
+            or args.label in REFERENCE_SYSTEMS):
+        parser.error("--label: letters, digits and _.+- only, not %s" %
+                     " or ".join(sorted(REFERENCE_SYSTEMS)))
+    try:
+        bench = Benchmark(args)
+    except ValueError as error:
+        parser.error("--mapper_options: %s" % error)
 
     if args.list:
         for name in DATASETS:
-            print(name + ("  (SPHERA and stock)" if name in STOCK_DATASETS else
-                          "  (SPHERA only)"))
+            unknown = unknown_models(bench.base, name)
+            print(name + ("  (SPHERA and %s)" % bench.reference if not unknown else
+                          "  (SPHERA only: %s unknown to %s)" %
+                          ("/".join(unknown), bench.reference)))
         return 0
     selected = [n.strip() for n in args.only.split(",") if n.strip()] or DATASETS
     unknown = [n for n in selected if n not in DATASETS]
@@ -902,12 +1294,17 @@ def main():
         parser.error("unknown data set(s) %s; known: %s" %
                      (", ".join(unknown), ", ".join(DATASETS)))
 
-    bench = Benchmark(args)
     os.makedirs(bench.output_dir, exist_ok=True)
     if not bench.wait_for(bench.colmap, "SPHERA colmap"):
-        print("benchmark_sfm: %s not found; build it with scripts/build.sh "
-              "(or pass --colmap, --wait_minutes)" % bench.colmap, file=sys.stderr)
+        print("benchmark_sfm: %s not found; build it with %s "
+              "(or pass --colmap, --wait_minutes)" %
+              (bench.colmap, bench.base["build_hint"]), file=sys.stderr)
         return 1
+    log("base %s: %s (label %s%s) against %s (%s)" % (
+        args.base, bench.colmap, bench.label,
+        ", mapper options " + args.mapper_options if args.mapper_options else "",
+        bench.base["reference_title"],
+        "not run" if args.no_stock else bench.reference_colmap))
 
     try:
         commands = subprocess.run([bench.colmap, "help"], capture_output=True,
@@ -919,30 +1316,26 @@ def main():
             log("warning: %s has no '%s' command; the steps that need it will "
                 "fail" % (bench.colmap, command))
 
-    rows = []
+    runs, rows = [], []
     for dataset in selected:
-        systems = ["sphera"]
-        if dataset in STOCK_DATASETS and not args.no_stock:
-            systems.append("stock")
-        for system in systems:
-            start = time.monotonic()
-            row = bench.run_one(dataset, system)
-            log("%s/%s: %s (%.0f s)" % (dataset, system, row["status"],
-                                        time.monotonic() - start))
-            rows.append(row)
+        dataset_runs, dataset_rows = bench.run_dataset(dataset)
+        runs += dataset_runs
+        rows += dataset_rows
 
     csv_path = os.path.join(bench.output_dir, "sfm_results.csv")
+    runs_path = os.path.join(bench.output_dir, "runs.csv")
     png_path = os.path.join(bench.output_dir, "sfm_results.png")
-    done = {(r["dataset"], r["system"]) for r in rows}
-    kept = [] if args.fresh else [r for r in read_csv(csv_path)
-                                  if (r.get("dataset"), r.get("system")) not in done]
-    all_rows = sort_rows(rows + kept)
+    all_rows, kept = merge_earlier(csv_path, rows, args.fresh)
     add_ratios(all_rows)
+    write_csv(csv_path, all_rows, COLUMNS)
+    all_runs, kept_runs = merge_earlier(runs_path, runs, args.fresh)
+    write_csv(runs_path, all_runs, RUN_COLUMNS)
     print()
-    print_table(sort_rows(rows))
-    write_csv(csv_path, all_rows)
-    print("\nwrote %s%s" % (csv_path, " (also %d row(s) of earlier runs)" % len(kept)
+    print_table(sort_rows(rows), bench.reference)
+    print("\nwrote %s%s" % (csv_path, " (also %d row(s) of earlier runs)" % kept
                             if kept else ""))
+    print("wrote %s%s" % (runs_path, " (also %d row(s) of earlier runs)" % kept_runs
+                          if kept_runs else ""))
     if write_png(png_path, all_rows):
         print("wrote " + png_path)
     return 0

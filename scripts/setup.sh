@@ -13,6 +13,10 @@ readonly PACKAGES=(
   libfreeimage-dev libmetis-dev libsqlite3-dev libboost-program-options-dev
   libboost-filesystem-dev libboost-graph-dev libboost-system-dev
   libsuitesparse-dev libgtest-dev libgl-dev
+  # COLMAP 4.x (SPHERA_COLMAP_BASE=4); OpenImageIO's CMake files need the
+  # tools and Imath's Python package
+  libopenimageio-dev openimageio-tools python3-imath libcurl4-openssl-dev
+  libomp-dev libblas-dev liblapack-dev
   # SPHERA: bearing-vector solvers, image remapping
   libopengv-dev libopencv-dev
   # tests, benchmarks and plots

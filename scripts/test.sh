@@ -6,11 +6,18 @@
 set -euo pipefail
 
 readonly REPO_ROOT="$(cd "$(dirname "$0")/.." && pwd)"
-readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build}"
+# SPHERA_COLMAP_BASE=4 builds on upstream COLMAP 4.x (into build-4/ unless
+# SPHERA_BUILD_DIR says otherwise); the default base is COLMAP 3.10.
+readonly COLMAP_BASE="${SPHERA_COLMAP_BASE:-3.10}"
+if [ "${COLMAP_BASE}" = 4 ]; then
+  readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build-4}"
+else
+  readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build}"
+fi
 start=$(date +%s)
 
 "${REPO_ROOT}/scripts/setup.sh"
-"${REPO_ROOT}/scripts/build.sh"
+SPHERA_BUILD_DIR="${BUILD_DIR}" "${REPO_ROOT}/scripts/build.sh"
 echo "test.sh: build ready after $(( $(date +%s) - start )) s"
 
 cd "${BUILD_DIR}"

@@ -5,8 +5,8 @@ import os
 import struct
 import unittest
 
-from cli_util import (Database, TempDirTestCase, read_text_cameras,
-                      run_colmap, write_noise_image)
+from cli_util import (CPU_EXTRACTION, EXTRACTION, Database, TempDirTestCase,
+                      read_text_cameras, run_colmap, write_noise_image)
 
 # One camera of every new model, with the ids upstream COLMAP 4.1 and our
 # README use.
@@ -103,8 +103,8 @@ class FeatureExtractionInputTest(TempDirTestCase):
     def extract(self, *extra, check=True):
         return run_colmap("feature_extractor", "--database_path",
                           self.database, "--image_path", self.path("images"),
-                          "--SiftExtraction.use_gpu", "0",
-                          "--SiftExtraction.num_threads", "2", *extra,
+                          *CPU_EXTRACTION,
+                          f"--{EXTRACTION}.num_threads", "2", *extra,
                           check=check)
 
     def assert_rejected(self, expected_text, *extra):

@@ -18,6 +18,16 @@ SHARED_DATA = os.environ.get(
 # ctest reports a test that exits with this code as skipped.
 SKIP_EXIT_CODE = 77
 
+# The COLMAP base the program was built on: "3.10" or "4" (upstream 4.x,
+# whose extraction and matching options are --FeatureExtraction.* and
+# --FeatureMatching.* where 3.10 had --SiftExtraction.* and --SiftMatching.*).
+COLMAP_BASE = os.environ.get("SPHERA_COLMAP_BASE", "3.10")
+EXTRACTION = "FeatureExtraction" if COLMAP_BASE == "4" else "SiftExtraction"
+MATCHING = "FeatureMatching" if COLMAP_BASE == "4" else "SiftMatching"
+# Feature extraction and matching on the CPU.
+CPU_EXTRACTION = [f"--{EXTRACTION}.use_gpu", "0"]
+CPU_MATCHING = [f"--{MATCHING}.use_gpu", "0"]
+
 
 def run_colmap(*args, check=True, timeout=1800):
     """Runs `colmap ARGS`, returns the CompletedProcess (stdout+stderr text)."""
@@ -104,6 +114,58 @@ def read_text_model(path):
             points[int(fields[0])] = (tuple(float(v) for v in fields[1:4]),
                                       track)
     return cameras, images, points
+
+
+def rotation_from_quaternion(qw, qx, qy, qz):
+    """Rotation matrix (numpy) of a unit quaternion (w, x, y, z)."""
+    import numpy as np
+    w, x, y, z = qw, qx, qy, qz
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def text_model_poses(path):
+    """{image name: (R cam_from_world, camera centre)} of a text model."""
+    import numpy as np
+    _, images, _ = read_text_model(path)
+    poses = {}
+    for fields, _ in images.values():
+        rotation = rotation_from_quaternion(*map(float, fields[1:5]))
+        translation = np.array([float(v) for v in fields[5:8]])
+        poses[fields[9]] = (rotation, -rotation.T @ translation)
+    return poses
+
+
+def pose_errors(gt_path, model_path):
+    """Aligns the text model at MODEL_PATH to the one at GT_PATH by the
+    least-squares similarity of the camera centres (Umeyama 1991) and returns
+    {image name: (rotation error in degrees, position error)} for the images
+    of both: ||log(R_gt R_est^T)|| and the distance of the centres."""
+    import numpy as np
+    gt = text_model_poses(gt_path)
+    est = text_model_poses(model_path)
+    names = sorted(set(gt) & set(est))
+    gt_centres = np.array([gt[n][1] for n in names])
+    est_centres = np.array([est[n][1] for n in names])
+    gt_mean, est_mean = gt_centres.mean(0), est_centres.mean(0)
+    gt_d, est_d = gt_centres - gt_mean, est_centres - est_mean
+    u, singular, vt = np.linalg.svd(gt_d.T @ est_d / len(names))
+    sign = np.eye(3)
+    if np.linalg.det(u @ vt) < 0:
+        sign[2, 2] = -1
+    gt_from_est = u @ sign @ vt
+    scale = np.trace(np.diag(singular) @ sign) / (est_d ** 2).sum(1).mean()
+    errors = {}
+    for name in names:
+        centre = scale * gt_from_est @ (est[name][1] - est_mean) + gt_mean
+        # est cam_from_world composed with est_from_gt maps gt world to cam.
+        relative = gt[name][0] @ (est[name][0] @ gt_from_est.T).T
+        angle = np.arccos(np.clip((np.trace(relative) - 1) / 2, -1, 1))
+        errors[name] = (np.degrees(angle),
+                        float(np.linalg.norm(centre - gt[name][1])))
+    return errors
 
 
 class Database:

@@ -4,8 +4,9 @@ the repository: the test is skipped without it)."""
 import os
 import unittest
 
-from cli_util import (SHARED_DATA, Database, TempDirTestCase, analyze_model,
-                      main_with_skip, run_colmap)
+from cli_util import (CPU_EXTRACTION, CPU_MATCHING, SHARED_DATA, Database,
+                      TempDirTestCase, analyze_model, main_with_skip,
+                      run_colmap)
 
 IMAGES = os.path.join(SHARED_DATA, "equirect_flat", "images")
 
@@ -16,7 +17,7 @@ class EquirectFlatTest(TempDirTestCase):
         run_colmap("feature_extractor", "--database_path", database_path,
                    "--image_path", IMAGES,
                    "--ImageReader.camera_model", "EQUIRECTANGULAR",
-                   "--SiftExtraction.use_gpu", "0")
+                   *CPU_EXTRACTION)
         database = Database(database_path)
         images = database.images()
         self.assertEqual(len(images), 11)
@@ -31,7 +32,7 @@ class EquirectFlatTest(TempDirTestCase):
         database.close()
 
         run_colmap("exhaustive_matcher", "--database_path", database_path,
-                   "--SiftMatching.use_gpu", "0")
+                   *CPU_MATCHING)
         database = Database(database_path)
         num_pairs = database.scalar("SELECT COUNT(*) FROM matches")
         self.assertEqual(num_pairs, 55)

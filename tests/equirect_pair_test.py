@@ -5,8 +5,9 @@ on the sphere and reconstructed by the mapper from that pair alone."""
 import os
 import unittest
 
-from cli_util import (SHARED_DATA, Database, TempDirTestCase, analyze_model,
-                      main_with_skip, run_colmap)
+from cli_util import (CPU_EXTRACTION, CPU_MATCHING, SHARED_DATA, Database,
+                      TempDirTestCase, analyze_model, main_with_skip,
+                      run_colmap)
 
 IMAGES = os.path.join(SHARED_DATA, "equirect_pair")
 
@@ -18,9 +19,9 @@ class EquirectPairTest(TempDirTestCase):
                    "--image_path", IMAGES,
                    "--ImageReader.camera_model", "EQUIRECTANGULAR",
                    "--ImageReader.single_camera", "1",
-                   "--SiftExtraction.use_gpu", "0")
+                   *CPU_EXTRACTION)
         run_colmap("exhaustive_matcher", "--database_path", database_path,
-                   "--SiftMatching.use_gpu", "0")
+                   *CPU_MATCHING)
         database = Database(database_path)
         self.assertEqual(len(database.images()), 2)
         (camera,) = database.cameras().values()

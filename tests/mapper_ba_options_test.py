@@ -13,7 +13,8 @@ import subprocess
 import tempfile
 import unittest
 
-from cli_util import TempDirTestCase, read_text_model, run_colmap
+from cli_util import (CPU_EXTRACTION, CPU_MATCHING, TempDirTestCase,
+                      read_text_model, run_colmap)
 
 RENDER = os.environ.get("SPHERA_RENDER", "")
 
@@ -33,9 +34,9 @@ class MapperBAOptionsTest(TempDirTestCase):
                    "--image_path", cls.images,
                    "--ImageReader.camera_model", "EQUIRECTANGULAR",
                    "--ImageReader.single_camera", "1",
-                   "--SiftExtraction.use_gpu", "0")
+                   *CPU_EXTRACTION)
         run_colmap("exhaustive_matcher", "--database_path", cls.database,
-                   "--SiftMatching.use_gpu", "0")
+                   *CPU_MATCHING)
 
     @classmethod
     def tearDownClass(cls):

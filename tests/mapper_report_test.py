@@ -7,7 +7,8 @@ import re
 import subprocess
 import unittest
 
-from cli_util import Database, TempDirTestCase, run_colmap, write_noise_image
+from cli_util import (CPU_EXTRACTION, CPU_MATCHING, Database, TempDirTestCase,
+                      run_colmap, write_noise_image)
 
 RENDER = os.environ.get("SPHERA_RENDER", "")
 WIDTH, HEIGHT = 640, 480
@@ -27,9 +28,9 @@ class MapperReportTest(TempDirTestCase):
                    "--ImageReader.camera_model", "PINHOLE",
                    "--ImageReader.camera_params", "320,320,320,240",
                    "--ImageReader.single_camera", "1",
-                   "--SiftExtraction.use_gpu", "0")
+                   *CPU_EXTRACTION)
         run_colmap("exhaustive_matcher", "--database_path", database,
-                   "--SiftMatching.use_gpu", "0")
+                   *CPU_MATCHING)
         return database
 
     def run_mapper(self, database, image_path, output="sparse",

@@ -8,7 +8,7 @@ import subprocess
 import sys
 import unittest
 
-from cli_util import TempDirTestCase, run_colmap
+from cli_util import CPU_EXTRACTION, CPU_MATCHING, TempDirTestCase, run_colmap
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
                                 "..", "scripts"))
@@ -47,9 +47,9 @@ class RenderedSfMTest(TempDirTestCase):
                        "--ImageReader.camera_model", model,
                        "--ImageReader.camera_params", ",".join(params),
                        "--ImageReader.single_camera", "1",
-                       "--SiftExtraction.use_gpu", "0")
+                       *CPU_EXTRACTION)
         run_colmap("exhaustive_matcher", "--database_path", database,
-                   "--SiftMatching.use_gpu", "0")
+                   *CPU_MATCHING)
         os.makedirs(self.path("sparse"))
         run_colmap("mapper", "--database_path", database, "--image_path",
                    os.path.join(scene, "images"), "--output_path",

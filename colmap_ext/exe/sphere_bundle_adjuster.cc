@@ -11,7 +11,6 @@
 #include "estimators/camera_only_bundle_adjustment.h"
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -391,23 +390,12 @@ bool RunCameraOnly(const SphereBundleAdjusterOptions& options,
   const sphera::CameraOnlyBAResult result =
       sphera::CameraOnlyBundleAdjustment(problem, ba);
   if (!result.Success()) {
-    // Name images by their file names rather than by their indices.
+    // The failing image by its file name.
     std::string text = result.message;
-    for (size_t i = ids.size(); i-- > 0;) {
-      const std::string key = "image " + std::to_string(i);
-      size_t pos = 0;
-      while ((pos = text.find(key, pos)) != std::string::npos) {
-        const size_t end = pos + key.size();
-        if ((end < text.size() && std::isdigit(text[end])) ||
-            (pos > 0 && text[pos - 1] != ' ')) {
-          pos = end;
-          continue;
-        }
-        const std::string name =
-            "image " + reconstruction->Image(ids[i]).Name();
-        text.replace(pos, key.size(), name);
-        pos += name.size();
-      }
+    if (result.image_idx >= 0 &&
+        result.image_idx < static_cast<int>(ids.size())) {
+      text = "image " + reconstruction->Image(ids[result.image_idx]).Name() +
+             " " + text;
     }
     std::ostringstream msg;
     msg << "camera-only BA failed (" << sphera::CameraOnlyBAStatusName(result.status)

@@ -1,0 +1,152 @@
+#include "colmap_ext/colmap4/exe/model_evaluator.h"
+
+#include "colmap/controllers/option_manager.h"
+#include "colmap/util/file.h"
+#include "colmap/util/logging.h"
+#include "colmap_ext/colmap4/controllers/model_evaluation.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+namespace colmap {
+namespace {
+
+// Writes next to `path` and renames, so a failed run never leaves a file
+// that looks complete.
+void WriteFileAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp_path = path + ".tmp";
+  {
+    std::ofstream file(tmp_path, std::ios::trunc);
+    THROW_CHECK_FILE_OPEN(file, tmp_path);
+    file << text;
+    if (!file) {
+      throw std::runtime_error("cannot write " + tmp_path);
+    }
+  }
+  if (std::rename(tmp_path.c_str(), path.c_str()) != 0) {
+    throw std::runtime_error("cannot rename " + tmp_path + " to " + path);
+  }
+}
+
+}  // namespace
+
+int RunModelEvaluator(int argc, char** argv) {
+  std::string gt_path;
+  std::string input_path;
+  std::string output_path;
+  ModelEvaluationOptions evaluation_options;
+
+  OptionManager options;
+  options.AddRequiredOption("gt_path", &gt_path);
+  options.AddRequiredOption("input_path", &input_path);
+  options.AddDefaultOption("output_path", &output_path);
+  options.AddDefaultOption("depth_path", &evaluation_options.depth_path);
+  options.AddDefaultOption("max_proj_center_error",
+                           &evaluation_options.max_proj_center_error);
+  options.Parse(argc, argv);
+
+  for (const auto& [name, path] :
+       {std::make_pair("gt_path", gt_path),
+        std::make_pair("input_path", input_path)}) {
+    if (!ExistsDir(path)) {
+      LOG(ERROR) << name << ": " << path << " is not a directory";
+      return EXIT_FAILURE;
+    }
+  }
+  if (!output_path.empty() && !ExistsDir(output_path)) {
+    LOG(ERROR) << "output_path: " << output_path << " is not a directory";
+    return EXIT_FAILURE;
+  }
+
+  ModelEvaluation evaluation;
+  try {
+    Reconstruction ground_truth;
+    try {
+      ground_truth.Read(gt_path);
+    } catch (const std::exception& error) {
+      throw std::invalid_argument("cannot read the ground truth " + gt_path +
+                                  ": " + error.what());
+    }
+    Reconstruction reconstruction;
+    try {
+      reconstruction.Read(input_path);
+    } catch (const std::exception& error) {
+      throw std::invalid_argument("cannot read the model " + input_path +
+                                  ": " + error.what());
+    }
+    evaluation = EvaluateModel(ground_truth, reconstruction, evaluation_options);
+  } catch (const std::exception& error) {
+    LOG(ERROR) << "model_evaluator: " << error.what();
+    return EXIT_FAILURE;
+  }
+
+  std::ostringstream table;
+  table << std::fixed;
+  table << "image                          reg   rot_err_deg  pos_err      "
+           "pos_err/baseline\n";
+  for (const ImageEvaluation& image : evaluation.images) {
+    table << std::left << std::setw(30) << image.name << " "
+          << (image.registered ? "yes" : "no ") << "   ";
+    if (image.registered) {
+      table << std::setprecision(5) << std::setw(12)
+            << image.rotation_error_deg << " " << std::setprecision(6)
+            << std::setw(12) << image.position_error << " "
+            << image.position_error_normalized;
+    }
+    table << "\n";
+  }
+  table << std::setprecision(6) << "registered: " << evaluation.num_registered
+        << "/" << evaluation.num_gt_images
+        << "\nrotation error (deg): mean " << evaluation.mean_rotation_error_deg
+        << " max " << evaluation.max_rotation_error_deg
+        << "\nposition error: mean " << evaluation.mean_position_error
+        << " max " << evaluation.max_position_error << " (mean "
+        << evaluation.mean_position_error_normalized
+        << " of the closest-pair baseline "
+        << evaluation.closest_pair_baseline << ")"
+        << "\nreprojection error: mean " << evaluation.mean_angular_error_rad
+        << " rad = " << evaluation.mean_angular_error_px << " px over "
+        << evaluation.num_observations << " observations\n";
+  for (const CameraEvaluation& camera : evaluation.cameras) {
+    table << "  camera " << camera.camera_id << " (" << camera.model_name
+          << "): " << camera.mean_angular_error_rad << " rad = "
+          << camera.mean_angular_error_px << " px\n";
+  }
+  if (evaluation.mean_point_error >= 0) {
+    table << "3D point error: mean " << evaluation.mean_point_error
+          << " median " << evaluation.median_point_error << " over "
+          << evaluation.num_points_with_depth << " points\n";
+  }
+  std::cout << table.str() << std::flush;
+
+  if (!output_path.empty()) {
+    std::ostringstream csv;
+    csv << std::setprecision(10)
+        << "name,registered,rotation_error_deg,position_error,"
+           "position_error_normalized\n";
+    for (const ImageEvaluation& image : evaluation.images) {
+      csv << image.name << "," << (image.registered ? 1 : 0) << ","
+          << image.rotation_error_deg << "," << image.position_error << ","
+          << image.position_error_normalized << "\n";
+    }
+    try {
+      WriteFileAtomically(
+          (std::filesystem::path(output_path) / "evaluation.json").string(),
+          ModelEvaluationToJson(evaluation));
+      WriteFileAtomically(
+          (std::filesystem::path(output_path) / "evaluation_images.csv")
+              .string(),
+          csv.str());
+    } catch (const std::exception& error) {
+      LOG(ERROR) << "model_evaluator: " << error.what();
+      return EXIT_FAILURE;
+    }
+  }
+  return EXIT_SUCCESS;
+}
+
+}  // namespace colmap

@@ -1,0 +1,19 @@
+#include "colmap_ext/colmap4/exe/sphera_commands.h"
+
+#include "colmap_ext/colmap4/exe/model_evaluator.h"
+#include "colmap_ext/colmap4/exe/sphere_bundle_adjuster.h"
+#include "colmap_ext/colmap4/exe/sphere_undistorter.h"
+#include "colmap_ext/colmap4/exe/strecha_importer.h"
+
+namespace colmap {
+
+std::vector<std::pair<std::string, SpheraCommandFunc>> SpheraCommands() {
+  return {
+      {"model_evaluator", &RunModelEvaluator},
+      {"sphere_bundle_adjuster", &RunSphereBundleAdjuster},
+      {"sphere_undistorter", &RunSphereUndistorter},
+      {"strecha_importer", &RunStrechaImporter},
+  };
+}
+
+}  // namespace colmap

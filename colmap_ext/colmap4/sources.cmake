@@ -1,0 +1,16 @@
+# Sources of colmap_ext/colmap4/controllers/ that the patch series compiles
+# into COLMAP's colmap_controllers library (the mapper and the commands call
+# them), and what they link. Included before COLMAP's CMake files are read.
+find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs)
+set(SPHERA_COLMAP_CONTROLLER_SRCS
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/mapper_report.cc
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/model_evaluation.cc
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_bundle_adjustment.cc
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_undistortion.cc
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/strecha_import.cc
+  ${CMAKE_CURRENT_LIST_DIR}/scene/camera_params_error.cc)
+set(SPHERA_COLMAP_CONTROLLER_LIBS
+  $<BUILD_INTERFACE:sphera_estimators>
+  $<BUILD_INTERFACE:opencv_core>
+  $<BUILD_INTERFACE:opencv_imgproc>
+  $<BUILD_INTERFACE:opencv_imgcodecs>)
