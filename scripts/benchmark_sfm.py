@@ -11,7 +11,8 @@ Usage (from the repository root):
   scripts/benchmark_sfm.py                      all data sets, SPHERA and stock
   scripts/benchmark_sfm.py --only room9_equirect,fountain-P11
   scripts/benchmark_sfm.py --quick --no_stock   smaller renders, SPHERA only
-  scripts/benchmark_sfm.py --quick --repeats 3  median and spread of 3 runs
+  scripts/benchmark_sfm.py --quick --repeats 3 --vary_seed
+                                                median and spread of 3 runs
   scripts/benchmark_sfm.py --base 4 --quick     SPHERA on 4.x vs upstream 4.x
   scripts/benchmark_sfm.py --mapper_options "--Mapper.ba_sphere_residual PIXEL"
                            --label pixel --no_stock   a second SPHERA setup,
@@ -53,15 +54,21 @@ model_analyzer) and the Strecha import (strecha_importer), whichever system
 reconstructed. --no_stock (or --no_reference) leaves the reference out.
 
 Repeats: with --repeats N every (data set, system) is reconstructed N times
-from the same rendered scene (RANSAC differs run to run); the runs of SPHERA
-and of the reference alternate, so that load changes on the machine hit
-both. The table and sfm_results.csv give the median over the successful
-runs of every number, and for the rotation and position errors and the
-extraction, matching, mapping and whole-pipeline (t_total_s = extract +
-match + map) times also the spread as min and max (columns <name>_min,
-<name>_max; table "median [min..max]"). Ratios SPHERA / reference
-(map_time_ratio, total_time_ratio, rot_err_ratio) are ratios of the
-medians. runs.csv has one row per single run.
+from the same rendered scene; the runs of SPHERA and of the reference
+alternate, so that load changes on the machine hit both. COLMAP seeds its
+random numbers with 0 in every command (3.10: --random_seed, 4.x:
+--default_random_seed), so plain repeats differ only by thread scheduling:
+the errors hardly move and the times show the machine's noise. With
+--vary_seed run k passes seed k-1 to every command of both systems (run 1 is
+the default run), so RANSAC differs from run to run. A system that failed
+before its mapper ran (missing data or program, render, extraction or
+matching failed) is not repeated. The table and sfm_results.csv give the
+median over the successful runs of every number, and for the rotation and
+position errors and the extraction, matching, mapping and whole-pipeline
+(t_total_s = extract + match + map) times also the spread as min and max
+(columns <name>_min, <name>_max; table "median [min..max]"). Ratios
+SPHERA / reference (map_time_ratio, total_time_ratio, rot_err_ratio) are
+ratios of the medians. runs.csv has one row per single run.
 
 --mapper_options "..." adds options to SPHERA's mapper only (split like a
 shell command line); --label NAME names SPHERA's rows (default "sphera"), so
@@ -127,6 +134,7 @@ BASES = {
         "reference_builder": os.path.join(REPO_ROOT, "scripts", "build_stock.sh"),
         "reference_build_minutes": 25,
         "extraction_gpu": "--SiftExtraction.use_gpu",
+        "seed_option": "--random_seed",
         "matching_gpu": "--SiftMatching.use_gpu",
     },
     "4": {
@@ -140,6 +148,7 @@ BASES = {
             REPO_ROOT, "..", "shared", "peers", "build_colmap4.sh")),
         "reference_build_minutes": 40,
         "extraction_gpu": "--FeatureExtraction.use_gpu",
+        "seed_option": "--default_random_seed",
         "matching_gpu": "--FeatureMatching.use_gpu",
     },
 }
@@ -177,7 +186,7 @@ def with_spread(keys):
 COLUMNS = (["dataset", "system", "base", "status", "runs", "runs_ok"]
            + with_spread(METRIC_KEYS) + [ratio for _, ratio in RATIOS]
            + ["mapper_options", "render", "timestamp"])
-RUN_COLUMNS = (["dataset", "system", "base", "repeat", "status"] + METRIC_KEYS
+RUN_COLUMNS = (["dataset", "system", "base", "repeat", "seed", "status"] + METRIC_KEYS
                + ["mapper_options", "render", "timestamp", "run_dir"])
 
 RENDER_SEED = 1
@@ -658,22 +667,24 @@ class Benchmark:
     # -- pipeline ------------------------------------------------------------
 
     def reconstruct(self, colmap, run_dir, image_path, groups, row,
-                    mapper_options=()):
+                    mapper_options=(), seed=None):
         """feature_extractor per camera group, exhaustive_matcher, mapper
-        (with extra `mapper_options`) with the option names of the base.
-        groups: [(model, params or None, image list or None)]. Fills the
-        times (t_total_s: their sum), num_models and returns the largest
-        model's directory."""
+        (with extra `mapper_options`) with the option names of the base;
+        every command with the random seed `seed` unless None (COLMAP's
+        default seed is 0). groups: [(model, params or None, image list or
+        None)]. Fills the times (t_total_s: their sum), num_models and
+        returns the largest model's directory."""
         logs = os.path.join(run_dir, "logs")
         database = os.path.join(run_dir, "database.db")
         timeout = self.args.step_timeout
+        seeded = [] if seed is None else [self.base["seed_option"], str(seed)]
         t_extract = 0.0
         for index, (model, params, image_list) in enumerate(groups):
             command = [colmap, "feature_extractor", "--database_path", database,
                        "--image_path", image_path,
                        "--ImageReader.camera_model", model,
                        "--ImageReader.single_camera_per_folder", "1",
-                       self.base["extraction_gpu"], "0"]
+                       self.base["extraction_gpu"], "0"] + seeded
             if params:
                 command += ["--ImageReader.camera_params",
                             ",".join(str(p) for p in params)]
@@ -692,7 +703,7 @@ class Benchmark:
         row["t_extract_s"] = round(t_extract, 3)
         seconds, _ = run_step("exhaustive_matcher",
                               [colmap, "exhaustive_matcher", "--database_path",
-                               database, self.base["matching_gpu"], "0"],
+                               database, self.base["matching_gpu"], "0"] + seeded,
                               logs, timeout)
         row["t_match_s"] = round(seconds, 3)
         sparse = os.path.join(run_dir, "sparse")
@@ -700,7 +711,8 @@ class Benchmark:
         seconds, _ = run_step("mapper",
                               [colmap, "mapper", "--database_path", database,
                                "--image_path", image_path, "--output_path",
-                               sparse] + list(mapper_options), logs, timeout)
+                               sparse] + seeded + list(mapper_options),
+                              logs, timeout)
         row["t_map_s"] = round(seconds, 3)
         row["t_total_s"] = round(row["t_extract_s"] + row["t_match_s"] +
                                  row["t_map_s"], 3)
@@ -829,8 +841,10 @@ class Benchmark:
         """One reconstruction and evaluation of `dataset` by `system` (the
         SPHERA label or the reference); returns the run's row."""
         is_reference = system == self.reference
+        seed = repeat - 1 if self.args.vary_seed else None
         row = {"dataset": dataset, "system": system, "base": self.args.base,
-               "repeat": repeat, "status": "ok",
+               "repeat": repeat, "seed": "" if seed is None else seed,
+               "status": "ok",
                "mapper_options": "" if is_reference
                else shlex.join(self.mapper_options),
                "timestamp": now(),
@@ -871,7 +885,7 @@ class Benchmark:
                 row["total"] = len(read_text_images(os.path.join(gt, "images.txt")))
             log("%s/%s run %d: reconstructing" % (dataset, system, repeat))
             model = self.reconstruct(colmap, run_dir, image_path, groups, row,
-                                     mapper_options)
+                                     mapper_options, seed)
             if gt:
                 self.evaluate(run_dir, model, gt, depth, row)
             else:
@@ -1235,6 +1249,9 @@ def make_parser():
                         help="smaller renders (supersample 2, cached separately)")
     parser.add_argument("--repeats", type=int, default=1,
                         help="runs per data set and system (default %(default)s)")
+    parser.add_argument("--vary_seed", action="store_true",
+                        help="run k uses random seed k-1 (default: COLMAP's "
+                             "fixed seed 0 in every run)")
     parser.add_argument("--no_stock", "--no_reference", dest="no_stock",
                         action="store_true",
                         help="no reference runs (stock or upstream; and no build)")
