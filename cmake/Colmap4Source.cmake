@@ -64,17 +64,6 @@ set(SPHERA_COLMAP4_TARBALL "" CACHE FILEPATH "colmap-5d968cf.tar.gz")
 set(SPHERA_POSELIB_TARBALL "" CACHE FILEPATH "PoseLib-a69263d.tar.gz")
 set(SPHERA_FAISS_TARBALL "" CACHE FILEPATH "faiss-1.14.1.tar.gz")
 
-# Extracts the pristine COLMAP 4.x source into `stage_dir`.
-function(sphera_stage_colmap4 stage_dir out_var)
-  sphera_find_tarball(${SPHERA_COLMAP4_NAME} ${SPHERA_COLMAP4_SHA256}
-                      SPHERA_COLMAP4_TARBALL tarball)
-  file(ARCHIVE_EXTRACT INPUT "${tarball}" DESTINATION "${stage_dir}")
-  if(NOT EXISTS "${stage_dir}/${SPHERA_COLMAP4_NAME}/src/colmap/sensor/models.h")
-    message(FATAL_ERROR "${tarball} does not unpack to ${SPHERA_COLMAP4_NAME}/")
-  endif()
-  set(${out_var} "${stage_dir}/${SPHERA_COLMAP4_NAME}" PARENT_SCOPE)
-endfunction()
-
 # PoseLib and faiss, unpacked once into the build tree (a stable path, so that
 # ccache hits across clones) and consumed by COLMAP's FetchContent without a
 # network.

@@ -54,9 +54,9 @@ function(sphera_verify_sha256 path expected what)
   endif()
 endfunction()
 
-# Extracts the pristine COLMAP 3.10 source into `stage_dir`; sets `out_var` to
-# the extracted tree.
-function(sphera_stage_colmap310 stage_dir out_var)
+# Sets `out_var` to the verified COLMAP 3.10 tarball, fetching it from
+# Debian's source registry when absent.
+function(sphera_colmap310_tarball out_var)
   set(tarball_ok FALSE)
   if(EXISTS "${SPHERA_COLMAP_TARBALL}")
     sphera_verify_sha256("${SPHERA_COLMAP_TARBALL}" "${SPHERA_COLMAP_SHA256}"
@@ -74,11 +74,21 @@ function(sphera_stage_colmap310 stage_dir out_var)
                           "-DSPHERA_COLMAP_TARBALL=/path/to/colmap_3.10.orig.tar.gz")
     endif()
   endif()
-  file(ARCHIVE_EXTRACT INPUT "${SPHERA_COLMAP_TARBALL}" DESTINATION "${stage_dir}")
-  set(${out_var} "${stage_dir}/colmap-3.10" PARENT_SCOPE)
+  set(${out_var} "${SPHERA_COLMAP_TARBALL}" PARENT_SCOPE)
 endfunction()
 
 function(sphera_prepare_colmap_source out_var)
+  # The source tarball is verified before anything is unpacked, so a missing
+  # or damaged file leaves no half-prepared tree.
+  set(tarball "")
+  if(NOT SPHERA_COLMAP_EDITABLE_DIR AND NOT SPHERA_COLMAP_SOURCE_DIR)
+    if(SPHERA_COLMAP_BASE STREQUAL "4")
+      sphera_find_tarball(${SPHERA_COLMAP4_NAME} ${SPHERA_COLMAP4_SHA256}
+                          SPHERA_COLMAP4_TARBALL tarball)
+    else()
+      sphera_colmap310_tarball(tarball)
+    endif()
+  endif()
   if(SPHERA_COLMAP_BASE STREQUAL "4")
     sphera_prepare_colmap4_dependencies()
   endif()
@@ -130,10 +140,18 @@ function(sphera_prepare_colmap_source out_var)
     file(COPY "${SPHERA_COLMAP_SOURCE_DIR}/" DESTINATION "${stage_dir}/colmap"
          PATTERN ".git" EXCLUDE)
     set(pristine_dir "${stage_dir}/colmap")
-  elseif(SPHERA_COLMAP_BASE STREQUAL "4")
-    sphera_stage_colmap4("${stage_dir}" pristine_dir)
   else()
-    sphera_stage_colmap310("${stage_dir}" pristine_dir)
+    file(ARCHIVE_EXTRACT INPUT "${tarball}" DESTINATION "${stage_dir}")
+    if(SPHERA_COLMAP_BASE STREQUAL "4")
+      set(pristine_dir "${stage_dir}/${SPHERA_COLMAP4_NAME}")
+    else()
+      set(pristine_dir "${stage_dir}/colmap-3.10")
+    endif()
+    if(NOT EXISTS "${pristine_dir}/src/colmap/sensor/models.h")
+      file(REMOVE_RECURSE "${stage_dir}")
+      message(FATAL_ERROR "${tarball} does not unpack to a COLMAP source tree "
+                          "at ${pristine_dir}")
+    endif()
   endif()
 
   find_program(PATCH_PROGRAM patch REQUIRED)
