@@ -57,7 +57,8 @@ def write_database(path, cameras, images, points):
                                (pair_id(i1, i2), len(matches), 2, data))
             # config 2 = CALIBRATED; the matrices are not used here.
             connection.execute(
-                "INSERT INTO two_view_geometries VALUES "
+                "INSERT INTO two_view_geometries (pair_id, rows, cols, data, "
+                "config, F, E, H, qvec, tvec) VALUES "
                 "(?, ?, ?, ?, 2, ?, ?, ?, ?, ?)",
                 (pair_id(i1, i2), len(matches), 2, data,
                  struct.pack("<9d", *[0.0] * 9),

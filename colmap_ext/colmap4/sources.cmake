@@ -3,6 +3,7 @@
 # them), and what they link. Included before COLMAP's CMake files are read.
 find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs)
 set(SPHERA_COLMAP_CONTROLLER_SRCS
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/image_errors.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/mapper_report.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/model_evaluation.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_bundle_adjustment.cc

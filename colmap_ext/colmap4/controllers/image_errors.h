@@ -1,0 +1,31 @@
+// Bad camera input and unreadable images in feature extraction: every image
+// that cannot be processed is named with the reason, the others are still
+// extracted, and the command exits non-zero.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace colmap {
+
+// Empty when --ImageReader.camera_model names a known model and
+// --ImageReader.camera_params (if given) are numbers that fit it; otherwise a
+// one-line message naming the option and what is wrong. Unlike COLMAP's
+// CSVToVector, "nan" and "inf" are read as numbers so that they are reported
+// as not finite rather than as unparsable.
+std::string ImageReaderCameraOptionsError(const std::string& camera_model,
+                                          const std::string& camera_params);
+
+// Thread-safe; records "image_name: message".
+void ReportImageError(const std::string& image_name, const std::string& message);
+
+std::vector<std::string> ImageErrors();
+
+void ClearImageErrors();
+
+// True for the file extensions of image formats COLMAP reads (case
+// insensitive). A file without one in an image folder (a README, a .txt) is
+// skipped, not an error.
+bool HasImageFileExtension(const std::string& path);
+
+}  // namespace colmap
