@@ -1,44 +1,58 @@
 # Prepares the patched COLMAP source tree at configure time.
 #
-# SPHERA_COLMAP_BASE selects the COLMAP base:
-#   3.10  COLMAP 3.10 from Debian's source registry, patch series
-#         colmap_ext/patches/ (the default while the port to 4.x is completed)
-#   4     upstream COLMAP 4.2.0.dev at commit 5d968cf with PoseLib and faiss
-#         (cmake/Colmap4Source.cmake), patch series colmap_ext/patches4/
+# The base is upstream COLMAP at commit 5d968cf (4.2.0.dev0, 2026-08-08) with
+# the PoseLib and faiss sources it builds with; the patch series is
+# colmap_ext/patches/.
 #
 # Source, in order of preference:
 #   SPHERA_COLMAP_EDITABLE_DIR  an editable, already patched checkout
 #                               (scripts/colmap_patches.sh checkout); used as is
 #   SPHERA_COLMAP_SOURCE_DIR    a pristine COLMAP source tree of the base
-#   the base's verified tarball (3.10: SPHERA_COLMAP_TARBALL, fetched from
-#   Debian's source registry into SPHERA_CACHE_DIR when absent; 4: see
-#   cmake/Colmap4Source.cmake)
+#   the verified tarball colmap-5d968cf.tar.gz (see below)
 # The patch series is applied in name order onto a staging copy; files are
 # then copied into the live tree only when their content changed, so a changed
 # patch rebuilds only what it touches.
-
-set(SPHERA_COLMAP_BASE "3.10" CACHE STRING "COLMAP base: 3.10 or 4")
-set_property(CACHE SPHERA_COLMAP_BASE PROPERTY STRINGS "3.10" "4")
-if(NOT SPHERA_COLMAP_BASE MATCHES "^(3\\.10|4)$")
-  message(FATAL_ERROR "SPHERA_COLMAP_BASE=${SPHERA_COLMAP_BASE}: expected 3.10 or 4")
-endif()
+#
+# The three tarballs (COLMAP, PoseLib, faiss) are looked up, in order, in
+# SPHERA_PEERS_DIR (default: the folder shared/peers beside the repository,
+# when present) and in SPHERA_CACHE_DIR; each can also be given on its own
+# with SPHERA_COLMAP4_TARBALL, SPHERA_POSELIB_TARBALL and
+# SPHERA_FAISS_TARBALL. Every tarball is checked against its pinned SHA-256
+# before use, and a missing or damaged one stops the configuration with a
+# message naming the file and the expected checksum. Nothing is downloaded:
+# the build needs no network when the tarballs are present. The commit id
+# names the same source in COLMAP's public repository.
 
 set(SPHERA_COLMAP_EDITABLE_DIR "" CACHE PATH
     "Editable patched COLMAP checkout, used as is")
 set(SPHERA_COLMAP_SOURCE_DIR "" CACHE PATH "Pristine COLMAP source tree of the base")
 set(SPHERA_CACHE_DIR "$ENV{HOME}/.cache/sphera" CACHE PATH
     "Where verified source tarballs are kept between builds")
-set(SPHERA_COLMAP_TARBALL "${SPHERA_CACHE_DIR}/colmap_3.10.orig.tar.gz"
-    CACHE FILEPATH "COLMAP 3.10 upstream tarball")
-set(SPHERA_COLMAP_SHA256
-    "61850f323e201ab6a1abbfb0e4a8b3ba1c4cedbf55e0a5716bdea1df8ae1813a")
+set(SPHERA_PATCH_DIR "${CMAKE_CURRENT_SOURCE_DIR}/colmap_ext/patches4")
 
-if(SPHERA_COLMAP_BASE STREQUAL "4")
-  include(${CMAKE_CURRENT_LIST_DIR}/Colmap4Source.cmake)
-  set(SPHERA_PATCH_DIR "${CMAKE_CURRENT_SOURCE_DIR}/colmap_ext/patches4")
-else()
-  set(SPHERA_PATCH_DIR "${CMAKE_CURRENT_SOURCE_DIR}/colmap_ext/patches")
+set(SPHERA_COLMAP_COMMIT "5d968cf38aa2")
+set(SPHERA_COLMAP_NAME "colmap-5d968cf")
+set(SPHERA_COLMAP_SHA256
+    "1c6c1a735774d8bc442900d52aac5359dcc9c7ffe53d3daba054fa3095de8dc1")
+set(SPHERA_POSELIB_NAME "PoseLib-a69263d")
+set(SPHERA_POSELIB_SHA256
+    "7b8d9b0aae73feeb7ba202261e1ff90dd7d166316b263210b6f9456303722e2d")
+set(SPHERA_FAISS_NAME "faiss-1.14.1")
+set(SPHERA_FAISS_SHA256
+    "0216d38d8c5c460433815b72d3cde6725eaa5d5770576277a2abc01ffc414d20")
+
+set(_sphera_default_peers "")
+get_filename_component(_sphera_shared_peers
+                       "${CMAKE_CURRENT_SOURCE_DIR}/../shared/peers" ABSOLUTE)
+if(EXISTS "${_sphera_shared_peers}/${SPHERA_COLMAP_NAME}.tar.gz")
+  set(_sphera_default_peers "${_sphera_shared_peers}")
 endif()
+set(SPHERA_PEERS_DIR "${_sphera_default_peers}" CACHE PATH
+    "Folder with colmap-5d968cf, PoseLib-a69263d and faiss-1.14.1 tarballs")
+
+set(SPHERA_COLMAP4_TARBALL "" CACHE FILEPATH "colmap-5d968cf.tar.gz")
+set(SPHERA_POSELIB_TARBALL "" CACHE FILEPATH "PoseLib-a69263d.tar.gz")
+set(SPHERA_FAISS_TARBALL "" CACHE FILEPATH "faiss-1.14.1.tar.gz")
 
 # Fails with a message naming the file and both checksums when the file at
 # `path` does not have the SHA-256 `expected`.
@@ -54,27 +68,60 @@ function(sphera_verify_sha256 path expected what)
   endif()
 endfunction()
 
-# Sets `out_var` to the verified COLMAP 3.10 tarball, fetching it from
-# Debian's source registry when absent.
-function(sphera_colmap310_tarball out_var)
-  set(tarball_ok FALSE)
-  if(EXISTS "${SPHERA_COLMAP_TARBALL}")
-    sphera_verify_sha256("${SPHERA_COLMAP_TARBALL}" "${SPHERA_COLMAP_SHA256}"
-                         "SPHERA_COLMAP_TARBALL")
-    set(tarball_ok TRUE)
+# Sets `out_var` to the tarball `name`.tar.gz: the cache variable `override`
+# when set, else the first of SPHERA_PEERS_DIR and SPHERA_CACHE_DIR holding it.
+# Verifies its SHA-256.
+function(sphera_find_tarball name sha256 override out_var)
+  set(candidates "")
+  if(${override})
+    list(APPEND candidates "${${override}}")
+  else()
+    foreach(dir "${SPHERA_PEERS_DIR}" "${SPHERA_CACHE_DIR}")
+      if(dir)
+        list(APPEND candidates "${dir}/${name}.tar.gz")
+      endif()
+    endforeach()
   endif()
-  if(NOT tarball_ok)
-    message(STATUS "Fetching the COLMAP 3.10 source from Debian's registry")
-    execute_process(
-      COMMAND bash "${CMAKE_CURRENT_SOURCE_DIR}/scripts/fetch_colmap_source.sh"
-              "${SPHERA_COLMAP_TARBALL}"
-      RESULT_VARIABLE fetch_result)
-    if(NOT fetch_result EQUAL 0)
-      message(FATAL_ERROR "Could not obtain the COLMAP 3.10 source; pass "
-                          "-DSPHERA_COLMAP_TARBALL=/path/to/colmap_3.10.orig.tar.gz")
+  foreach(candidate ${candidates})
+    if(EXISTS "${candidate}")
+      sphera_verify_sha256("${candidate}" "${sha256}" "${name}")
+      set(${out_var} "${candidate}" PARENT_SCOPE)
+      return()
     endif()
-  endif()
-  set(${out_var} "${SPHERA_COLMAP_TARBALL}" PARENT_SCOPE)
+  endforeach()
+  string(REPLACE ";" ", " searched "${candidates}")
+  message(FATAL_ERROR
+    "${name}.tar.gz (SHA-256 ${sha256}) not found; searched: ${searched}. "
+    "Put it in ${SPHERA_CACHE_DIR} or pass -D${override}=/path/${name}.tar.gz "
+    "(the COLMAP source is commit ${SPHERA_COLMAP_COMMIT} of COLMAP's public "
+    "repository).")
+endfunction()
+
+# PoseLib and faiss, unpacked once into the build tree (a stable path, so that
+# ccache hits across clones) and consumed by COLMAP's FetchContent without a
+# network.
+function(sphera_prepare_colmap_dependencies)
+  set(deps_dir "${CMAKE_BINARY_DIR}/colmap-deps")
+  foreach(dep POSELIB FAISS)
+    set(name ${SPHERA_${dep}_NAME})
+    set(source_dir "${deps_dir}/${name}")
+    if(NOT EXISTS "${source_dir}/CMakeLists.txt")
+      sphera_find_tarball(${name} ${SPHERA_${dep}_SHA256}
+                          SPHERA_${dep}_TARBALL tarball)
+      file(REMOVE_RECURSE "${deps_dir}/stage-${name}")
+      file(ARCHIVE_EXTRACT INPUT "${tarball}"
+           DESTINATION "${deps_dir}/stage-${name}")
+      if(NOT EXISTS "${deps_dir}/stage-${name}/${name}/CMakeLists.txt")
+        message(FATAL_ERROR "${tarball} does not unpack to ${name}/")
+      endif()
+      file(RENAME "${deps_dir}/stage-${name}/${name}" "${source_dir}")
+      file(REMOVE_RECURSE "${deps_dir}/stage-${name}")
+    endif()
+    set(FETCHCONTENT_SOURCE_DIR_${dep} "${source_dir}" CACHE PATH "" FORCE)
+  endforeach()
+  set(FETCHCONTENT_FULLY_DISCONNECTED ON CACHE BOOL "" FORCE)
+  set(ONNX_ENABLED OFF CACHE BOOL "" FORCE)
+  set(DOWNLOAD_ENABLED OFF CACHE BOOL "" FORCE)
 endfunction()
 
 function(sphera_prepare_colmap_source out_var)
@@ -82,16 +129,10 @@ function(sphera_prepare_colmap_source out_var)
   # or damaged file leaves no half-prepared tree.
   set(tarball "")
   if(NOT SPHERA_COLMAP_EDITABLE_DIR AND NOT SPHERA_COLMAP_SOURCE_DIR)
-    if(SPHERA_COLMAP_BASE STREQUAL "4")
-      sphera_find_tarball(${SPHERA_COLMAP4_NAME} ${SPHERA_COLMAP4_SHA256}
-                          SPHERA_COLMAP4_TARBALL tarball)
-    else()
-      sphera_colmap310_tarball(tarball)
-    endif()
+    sphera_find_tarball(${SPHERA_COLMAP_NAME} ${SPHERA_COLMAP_SHA256}
+                        SPHERA_COLMAP4_TARBALL tarball)
   endif()
-  if(SPHERA_COLMAP_BASE STREQUAL "4")
-    sphera_prepare_colmap4_dependencies()
-  endif()
+  sphera_prepare_colmap_dependencies()
   if(SPHERA_COLMAP_EDITABLE_DIR)
     if(NOT EXISTS "${SPHERA_COLMAP_EDITABLE_DIR}/src/colmap/sensor/models.h")
       message(FATAL_ERROR "SPHERA_COLMAP_EDITABLE_DIR=${SPHERA_COLMAP_EDITABLE_DIR} "
@@ -103,14 +144,13 @@ function(sphera_prepare_colmap_source out_var)
 
   file(GLOB patches "${SPHERA_PATCH_DIR}/*.patch")
   list(SORT patches)
-  if(SPHERA_STOCK_COLMAP)
-    set(patches "")
-  endif()
   set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS
                ${patches} "${SPHERA_PATCH_DIR}")
 
   # The stamp names the base, the pristine source and every patch's content.
-  set(stamp_text "base=${SPHERA_COLMAP_BASE}\nsource=${SPHERA_COLMAP_SOURCE_DIR}\n")
+  # "base=4" is the line build trees of the 4.x base have always had; the
+  # tree of an older base is removed below.
+  set(stamp_text "base=4\nsource=${SPHERA_COLMAP_SOURCE_DIR}\n")
   foreach(patch ${patches})
     file(SHA256 "${patch}" patch_hash)
     string(APPEND stamp_text "${patch_hash}\n")
@@ -123,8 +163,8 @@ function(sphera_prepare_colmap_source out_var)
       set(${out_var} "${live_dir}" PARENT_SCOPE)
       return()
     endif()
-    # Another base or series: files of the old tree must not linger.
-    if(NOT old_stamp MATCHES "^base=${SPHERA_COLMAP_BASE}\n")
+    # Another base: files of the old tree must not linger.
+    if(NOT old_stamp MATCHES "^base=4\n")
       file(REMOVE_RECURSE "${live_dir}")
     endif()
   endif()
@@ -142,11 +182,7 @@ function(sphera_prepare_colmap_source out_var)
     set(pristine_dir "${stage_dir}/colmap")
   else()
     file(ARCHIVE_EXTRACT INPUT "${tarball}" DESTINATION "${stage_dir}")
-    if(SPHERA_COLMAP_BASE STREQUAL "4")
-      set(pristine_dir "${stage_dir}/${SPHERA_COLMAP4_NAME}")
-    else()
-      set(pristine_dir "${stage_dir}/colmap-3.10")
-    endif()
+    set(pristine_dir "${stage_dir}/${SPHERA_COLMAP_NAME}")
     if(NOT EXISTS "${pristine_dir}/src/colmap/sensor/models.h")
       file(REMOVE_RECURSE "${stage_dir}")
       message(FATAL_ERROR "${tarball} does not unpack to a COLMAP source tree "

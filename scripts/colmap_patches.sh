@@ -6,37 +6,26 @@
 #   colmap_patches.sh export DIR     rewrite the patch series from the
 #                                    commits in DIR after the pristine one
 #
-# SPHERA_COLMAP_BASE=4 works on upstream COLMAP 4.x (commit 5d968cf, tarball
-# from SPHERA_PEERS_DIR, default ../shared/peers, or ~/.cache/sphera) and
-# colmap_ext/patches4/; the default, 3.10, on colmap_ext/patches/.
+# The pristine source is upstream COLMAP 4.x at commit 5d968cf: the tarball
+# colmap-5d968cf.tar.gz from SPHERA_PEERS_DIR (default ../shared/peers), else
+# from ~/.cache/sphera, or the file SPHERA_COLMAP4_TARBALL names.
 #
 # Build against the checkout with
-#   cmake -B build -DSPHERA_COLMAP_EDITABLE_DIR=DIR [-DSPHERA_COLMAP_BASE=4]
+#   cmake -B build -DSPHERA_COLMAP_EDITABLE_DIR=DIR
 # and edit it with ordinary git (commit --fixup, rebase -i, one commit per
 # topic); never edit .patch files by hand.
 set -euo pipefail
 
 readonly REPO_ROOT="$(cd "$(dirname "$0")/.." && pwd)"
-readonly BASE="${SPHERA_COLMAP_BASE:-3.10}"
-case "${BASE}" in
-  3.10)
-    readonly PATCH_DIR="${REPO_ROOT}/colmap_ext/patches"
-    readonly TARBALL="${SPHERA_COLMAP_TARBALL:-${HOME}/.cache/sphera/colmap_3.10.orig.tar.gz}"
-    ;;
-  4)
-    readonly PATCH_DIR="${REPO_ROOT}/colmap_ext/patches4"
-    readonly COLMAP4_SHA256="1c6c1a735774d8bc442900d52aac5359dcc9c7ffe53d3daba054fa3095de8dc1"
-    peers="${SPHERA_PEERS_DIR:-${REPO_ROOT}/../shared/peers}"
-    TARBALL="${SPHERA_COLMAP4_TARBALL:-${peers}/colmap-5d968cf.tar.gz}"
-    [ -f "${TARBALL}" ] || TARBALL="${HOME}/.cache/sphera/colmap-5d968cf.tar.gz"
-    readonly TARBALL
-    ;;
-  *)
-    echo "error: SPHERA_COLMAP_BASE=${BASE}: expected 3.10 or 4" >&2
-    exit 2
-    ;;
-esac
-readonly PRISTINE_TAG="pristine-${BASE}"
+readonly PATCH_DIR="${REPO_ROOT}/colmap_ext/patches4"
+readonly COLMAP_SHA256="1c6c1a735774d8bc442900d52aac5359dcc9c7ffe53d3daba054fa3095de8dc1"
+peers="${SPHERA_PEERS_DIR:-${REPO_ROOT}/../shared/peers}"
+TARBALL="${SPHERA_COLMAP4_TARBALL:-${peers}/colmap-5d968cf.tar.gz}"
+[ -f "${TARBALL}" ] || TARBALL="${HOME}/.cache/sphera/colmap-5d968cf.tar.gz"
+readonly TARBALL
+# The name checkouts have carried since the 4.x port, so that older ones
+# still export.
+readonly PRISTINE_TAG="pristine-4"
 
 git_in() { git -C "$1" -c user.name=sphera -c user.email=sphera@localhost "${@:2}"; }
 
@@ -53,19 +42,15 @@ case "${command}" in
       echo "error: ${dir} already exists" >&2
       exit 1
     fi
-    if [ "${BASE}" = 4 ]; then
-      echo "${COLMAP4_SHA256}  ${TARBALL}" | sha256sum --check --status || {
-        echo "error: ${TARBALL} is missing or does not have SHA-256 ${COLMAP4_SHA256}" >&2
-        exit 1
-      }
-    else
-      "${REPO_ROOT}/scripts/fetch_colmap_source.sh" "${TARBALL}"
-    fi
+    echo "${COLMAP_SHA256}  ${TARBALL}" | sha256sum --check --status || {
+      echo "error: ${TARBALL} is missing or does not have SHA-256 ${COLMAP_SHA256}" >&2
+      exit 1
+    }
     mkdir -p "${dir}"
     tar -xzf "${TARBALL}" -C "${dir}" --strip-components=1
     git_in "${dir}" init -q
     git_in "${dir}" add -A
-    git_in "${dir}" commit -q -m "COLMAP ${BASE} (pristine)"
+    git_in "${dir}" commit -q -m "COLMAP 5d968cf (pristine)"
     git_in "${dir}" tag "${PRISTINE_TAG}"
     for patch in "${PATCH_DIR}"/*.patch; do
       [ -e "${patch}" ] || continue

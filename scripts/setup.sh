@@ -8,13 +8,13 @@ readonly PACKAGES=(
   # toolchain
   build-essential cmake ninja-build ccache git patch ca-certificates
   dpkg-dev xz-utils
-  # COLMAP 3.10
+  # COLMAP
   libeigen3-dev libgoogle-glog-dev libgflags-dev libceres-dev libflann-dev
   libfreeimage-dev libmetis-dev libsqlite3-dev libboost-program-options-dev
   libboost-filesystem-dev libboost-graph-dev libboost-system-dev
   libsuitesparse-dev libgtest-dev libgl-dev
-  # COLMAP 4.x (SPHERA_COLMAP_BASE=4); OpenImageIO's CMake files need the
-  # tools and Imath's Python package
+  # more of COLMAP: image I/O (OpenImageIO), OpenMP, BLAS/LAPACK;
+  # OpenImageIO's CMake files need the tools and Imath's Python package
   libopenimageio-dev openimageio-tools python3-imath libcurl4-openssl-dev
   libomp-dev libblas-dev liblapack-dev
   # SPHERA: bearing-vector solvers, image remapping

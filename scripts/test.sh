@@ -6,14 +6,7 @@
 set -euo pipefail
 
 readonly REPO_ROOT="$(cd "$(dirname "$0")/.." && pwd)"
-# SPHERA_COLMAP_BASE=4 builds on upstream COLMAP 4.x (into build-4/ unless
-# SPHERA_BUILD_DIR says otherwise); the default base is COLMAP 3.10.
-readonly COLMAP_BASE="${SPHERA_COLMAP_BASE:-3.10}"
-if [ "${COLMAP_BASE}" = 4 ]; then
-  readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build-4}"
-else
-  readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build}"
-fi
+readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build}"
 start=$(date +%s)
 
 "${REPO_ROOT}/scripts/setup.sh"

@@ -18,12 +18,10 @@ SHARED_DATA = os.environ.get(
 # ctest reports a test that exits with this code as skipped.
 SKIP_EXIT_CODE = 77
 
-# The COLMAP base the program was built on: "3.10" or "4" (upstream 4.x,
-# whose extraction and matching options are --FeatureExtraction.* and
-# --FeatureMatching.* where 3.10 had --SiftExtraction.* and --SiftMatching.*).
-COLMAP_BASE = os.environ.get("SPHERA_COLMAP_BASE", "3.10")
-EXTRACTION = "FeatureExtraction" if COLMAP_BASE == "4" else "SiftExtraction"
-MATCHING = "FeatureMatching" if COLMAP_BASE == "4" else "SiftMatching"
+# Prefixes of COLMAP's feature extraction and matching options
+# (--FeatureExtraction.*, --FeatureMatching.*).
+EXTRACTION = "FeatureExtraction"
+MATCHING = "FeatureMatching"
 # Feature extraction and matching on the CPU.
 CPU_EXTRACTION = [f"--{EXTRACTION}.use_gpu", "0"]
 CPU_MATCHING = [f"--{MATCHING}.use_gpu", "0"]

@@ -10,7 +10,7 @@ import unittest
 from cli_util import TempDirTestCase
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-COLMAP4_SHA256 = \
+COLMAP_SHA256 = \
     "1c6c1a735774d8bc442900d52aac5359dcc9c7ffe53d3daba054fa3095de8dc1"
 
 
@@ -19,7 +19,7 @@ class ColmapSourceTest(TempDirTestCase):
         build_dir = self.path("build")
         result = subprocess.run(
             ["cmake", "-S", REPO_ROOT, "-B", build_dir, "-G", "Ninja",
-             "-DSPHERA_COLMAP_BASE=4", "-DSPHERA_COLMAP4_TARBALL=" + tarball],
+             "-DSPHERA_COLMAP4_TARBALL=" + tarball],
             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
             timeout=600)
         return result, build_dir
@@ -29,9 +29,9 @@ class ColmapSourceTest(TempDirTestCase):
         message = " ".join(result.stdout.split())
         self.assertNotEqual(result.returncode, 0, message)
         self.assertIn(tarball, message)
-        self.assertIn(COLMAP4_SHA256, message)
+        self.assertIn(COLMAP_SHA256, message)
         for leftover in ("build.ninja", "colmap-src", "colmap-stage",
-                         "colmap4-deps"):
+                         "colmap-deps"):
             self.assertFalse(os.path.exists(os.path.join(build_dir, leftover)),
                              leftover)
         return message
