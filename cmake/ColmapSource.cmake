@@ -28,7 +28,7 @@ set(SPHERA_COLMAP_EDITABLE_DIR "" CACHE PATH
 set(SPHERA_COLMAP_SOURCE_DIR "" CACHE PATH "Pristine COLMAP source tree of the base")
 set(SPHERA_CACHE_DIR "$ENV{HOME}/.cache/sphera" CACHE PATH
     "Where verified source tarballs are kept between builds")
-set(SPHERA_PATCH_DIR "${CMAKE_CURRENT_SOURCE_DIR}/colmap_ext/patches4")
+set(SPHERA_PATCH_DIR "${CMAKE_CURRENT_SOURCE_DIR}/colmap_ext/patches")
 
 set(SPHERA_COLMAP_COMMIT "5d968cf38aa2")
 set(SPHERA_COLMAP_NAME "colmap-5d968cf")

@@ -17,7 +17,7 @@
 set -euo pipefail
 
 readonly REPO_ROOT="$(cd "$(dirname "$0")/.." && pwd)"
-readonly PATCH_DIR="${REPO_ROOT}/colmap_ext/patches4"
+readonly PATCH_DIR="${REPO_ROOT}/colmap_ext/patches"
 readonly COLMAP_SHA256="1c6c1a735774d8bc442900d52aac5359dcc9c7ffe53d3daba054fa3095de8dc1"
 peers="${SPHERA_PEERS_DIR:-${REPO_ROOT}/../shared/peers}"
 TARBALL="${SPHERA_COLMAP4_TARBALL:-${peers}/colmap-5d968cf.tar.gz}"

@@ -1,4 +1,4 @@
-#include "colmap_ext/colmap4/controllers/model_evaluation.h"
+#include "colmap_ext/controllers/model_evaluation.h"
 
 #include "colmap/estimators/alignment.h"
 #include "colmap/geometry/pose.h"

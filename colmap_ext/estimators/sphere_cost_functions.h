@@ -22,7 +22,7 @@
 
 #include "colmap/estimators/cost_functions/reprojection_error.h"
 #include "colmap/scene/camera.h"
-#include "colmap_ext/colmap4/estimators/sphere_residual_type.h"
+#include "colmap_ext/estimators/sphere_residual_type.h"
 
 #include "camera_models/common.h"
 #include "camera_models/equirectangular.h"

@@ -1,4 +1,4 @@
-#include "colmap_ext/colmap4/scene/camera_params_error.h"
+#include "colmap_ext/scene/camera_params_error.h"
 
 #include "camera_models/registry.h"
 

@@ -1,9 +1,9 @@
-#include "colmap_ext/colmap4/exe/model_evaluator.h"
+#include "colmap_ext/exe/model_evaluator.h"
 
 #include "colmap/controllers/option_manager.h"
 #include "colmap/util/file.h"
 #include "colmap/util/logging.h"
-#include "colmap_ext/colmap4/controllers/model_evaluation.h"
+#include "colmap_ext/controllers/model_evaluation.h"
 
 #include <cstdio>
 #include <filesystem>

@@ -1,10 +1,10 @@
-#include "colmap_ext/colmap4/exe/strecha_importer.h"
+#include "colmap_ext/exe/strecha_importer.h"
 
 #include "colmap/controllers/option_manager.h"
 #include "colmap/util/file.h"
 #include "colmap/util/logging.h"
 #include "colmap/util/string.h"
-#include "colmap_ext/colmap4/controllers/strecha_import.h"
+#include "colmap_ext/controllers/strecha_import.h"
 
 namespace colmap {
 

@@ -1,10 +1,10 @@
-#include "colmap_ext/colmap4/exe/sphere_bundle_adjuster.h"
+#include "colmap_ext/exe/sphere_bundle_adjuster.h"
 
 #include "colmap/controllers/option_manager.h"
 #include "colmap/scene/reconstruction.h"
 #include "colmap/util/file.h"
 #include "colmap/util/logging.h"
-#include "colmap_ext/colmap4/controllers/sphere_bundle_adjustment.h"
+#include "colmap_ext/controllers/sphere_bundle_adjustment.h"
 
 #include <cstdlib>
 #include <exception>

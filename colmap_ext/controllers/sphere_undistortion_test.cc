@@ -1,4 +1,4 @@
-#include "colmap_ext/colmap4/controllers/sphere_undistortion.h"
+#include "colmap_ext/controllers/sphere_undistortion.h"
 
 #include "colmap/image/undistortion.h"
 #include "colmap/scene/reconstruction.h"

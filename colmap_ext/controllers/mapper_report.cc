@@ -1,4 +1,4 @@
-#include "colmap_ext/colmap4/controllers/mapper_report.h"
+#include "colmap_ext/controllers/mapper_report.h"
 
 #include <algorithm>
 #include <unordered_map>

@@ -1,10 +1,10 @@
-#include "colmap_ext/colmap4/exe/sphere_undistorter.h"
+#include "colmap_ext/exe/sphere_undistorter.h"
 
 #include "colmap/controllers/option_manager.h"
 #include "colmap/scene/reconstruction.h"
 #include "colmap/util/file.h"
 #include "colmap/util/logging.h"
-#include "colmap_ext/colmap4/controllers/sphere_undistortion.h"
+#include "colmap_ext/controllers/sphere_undistortion.h"
 
 #include <cstdlib>
 #include <exception>

@@ -1,9 +1,9 @@
-#include "colmap_ext/colmap4/controllers/image_errors.h"
+#include "colmap_ext/controllers/image_errors.h"
 
 #include "colmap/scene/camera.h"
 #include "colmap/sensor/models.h"
 #include "colmap/util/string.h"
-#include "colmap_ext/colmap4/scene/camera_params_error.h"
+#include "colmap_ext/scene/camera_params_error.h"
 
 #include <algorithm>
 #include <array>

@@ -21,7 +21,7 @@
 
 #include "colmap/geometry/rigid3.h"
 #include "colmap/scene/camera.h"
-#include "colmap_ext/colmap4/scene/camera_params_error.h"
+#include "colmap_ext/scene/camera_params_error.h"
 #include "colmap/scene/reconstruction.h"
 
 #include <cstddef>

@@ -1,10 +1,10 @@
-#include "colmap_ext/colmap4/controllers/sphere_bundle_adjustment.h"
+#include "colmap_ext/controllers/sphere_bundle_adjustment.h"
 
 #include "colmap/geometry/rigid3.h"
 #include "colmap/scene/camera.h"
 #include "colmap/scene/image.h"
 #include "colmap/scene/reconstruction.h"
-#include "colmap_ext/colmap4/exe/sphere_bundle_adjuster.h"
+#include "colmap_ext/exe/sphere_bundle_adjuster.h"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "colmap_ext/colmap4/controllers/strecha_import.h"
+#include "colmap_ext/controllers/strecha_import.h"
 
 #include "colmap/util/logging.h"
 #include "colmap/util/string.h"

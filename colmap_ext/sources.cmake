@@ -1,6 +1,7 @@
-# Sources of colmap_ext/colmap4/controllers/ that the patch series compiles
-# into COLMAP's colmap_controllers library (the mapper and the commands call
-# them), and what they link. Included before COLMAP's CMake files are read.
+# Sources of colmap_ext/controllers/ (and scene/) that the patch series
+# compiles into COLMAP's colmap_controllers library (the mapper and the
+# commands call them), and what they link. Included before COLMAP's CMake
+# files are read.
 find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs)
 set(SPHERA_COLMAP_CONTROLLER_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/controllers/image_errors.cc

@@ -1,4 +1,4 @@
-#include "colmap_ext/colmap4/controllers/sphere_bundle_adjustment.h"
+#include "colmap_ext/controllers/sphere_bundle_adjustment.h"
 
 #include "colmap/estimators/bundle_adjustment.h"
 #include "colmap/estimators/bundle_adjustment_ceres.h"
@@ -7,8 +7,8 @@
 #include "colmap/estimators/cost_functions/utils.h"
 #include "colmap/sensor/models.h"
 #include "colmap/util/logging.h"
-#include "colmap_ext/colmap4/estimators/sphere_cost_functions.h"
-#include "colmap_ext/colmap4/scene/camera_params_error.h"
+#include "colmap_ext/estimators/sphere_cost_functions.h"
+#include "colmap_ext/scene/camera_params_error.h"
 
 #include "camera_models/registry.h"
 #include "estimators/angular_residual.h"
@@ -120,9 +120,10 @@ std::vector<image_t> SortedRegImageIds(const Reconstruction& reconstruction) {
   return ids;
 }
 
-// The camera's parameters named like 3.10's Camera::ParamsError: wrong count,
-// not finite, non-positive focal length, and the models' own checks
-// (camera_models/, e.g. EQUIRECTANGULAR w = 2 h = the image size).
+// The camera's parameters are checked by CameraParamsError
+// (colmap_ext/scene/camera_params_error.h): wrong count, not finite,
+// non-positive focal length, and the models' own checks (camera_models/,
+// e.g. EQUIRECTANGULAR w = 2 h = the image size).
 
 size_t NumImagesInFrame(const Frame& frame) {
   size_t num_images = 0;
@@ -218,7 +219,7 @@ bool CheckModel(const Options& options,
 // The residual of one observation in the intrinsics step of the camera-only
 // mode, with the parameter blocks point3D (3), cam_from_world (7) and camera
 // params: for a spherical camera the angular residual of bundle adjustment
-// (colmap_ext/colmap4/estimators/sphere_cost_functions.h), for a perspective
+// (colmap_ext/estimators/sphere_cost_functions.h), for a perspective
 // one COLMAP's pixel reprojection error.
 ceres::CostFunction* CreateObservationCost(const Camera& camera,
                                            const Eigen::Vector2d& point2D) {

@@ -1,9 +1,9 @@
-#include "colmap_ext/colmap4/exe/sphera_commands.h"
+#include "colmap_ext/exe/sphera_commands.h"
 
-#include "colmap_ext/colmap4/exe/model_evaluator.h"
-#include "colmap_ext/colmap4/exe/sphere_bundle_adjuster.h"
-#include "colmap_ext/colmap4/exe/sphere_undistorter.h"
-#include "colmap_ext/colmap4/exe/strecha_importer.h"
+#include "colmap_ext/exe/model_evaluator.h"
+#include "colmap_ext/exe/sphere_bundle_adjuster.h"
+#include "colmap_ext/exe/sphere_undistorter.h"
+#include "colmap_ext/exe/strecha_importer.h"
 
 namespace colmap {
 
