@@ -98,8 +98,8 @@ class SphereModelsOnColmap4Test(TempDirTestCase):
         self.assertGreater(behind, 100)
 
     def test_unified_omni_190_degree_room(self):
-        # The SfM benchmark's room_fisheye190 set; 3.10-based SPHERA measured
-        # 0.0034 degrees and 0.21 mm there.
+        # The SfM benchmark's room_fisheye190 set; SPHERA on its former
+        # COLMAP base measured 0.0034 degrees and 0.21 mm there.
         scene = self.path("fisheye190")
         render(scene, fisheye190_rig())
         cameras, _, _ = read_text_model(os.path.join(scene, "sparse_gt"))
