@@ -603,7 +603,7 @@ def run_sift_residuals(args, bench, root):
     residual is its maximum-likelihood estimator), the noise here is the
     detector's own."""
     sfm_args = benchmark_sfm.make_parser().parse_args(
-        ["--quick", "--no_stock", "--output_dir", os.path.join(root, "sfm"),
+        ["--quick", "--no_upstream", "--output_dir", os.path.join(root, "sfm"),
          "--colmap", args.colmap, "--render", args.render])
     sfm = benchmark_sfm.Benchmark(sfm_args)
     rows = []

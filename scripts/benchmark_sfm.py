@@ -1,22 +1,24 @@
 #!/usr/bin/python3
-"""SfM benchmark of SPHERA against unpatched COLMAP of the same base.
+"""SfM benchmark of SPHERA against unpatched upstream COLMAP of the same base.
 
 Runs the COLMAP command-line pipeline (feature_extractor, exhaustive_matcher,
-mapper) on each data set with SPHERA and with the reference system (stock
-COLMAP 3.10, or upstream COLMAP 4.x with --base 4), evaluates the largest
-model against the ground truth with SPHERA's `colmap model_evaluator`, and
-writes a table, two CSVs and a PNG.
+mapper) on each data set with SPHERA and with the reference system
+(unpatched upstream COLMAP 4.x), evaluates the largest model against the
+ground truth with SPHERA's `colmap model_evaluator`, and writes a table, two
+CSVs and a PNG.
 
 Usage (from the repository root):
-  scripts/benchmark_sfm.py                      all data sets, SPHERA and stock
+  scripts/benchmark_sfm.py                      all data sets, SPHERA and
+                                                upstream
   scripts/benchmark_sfm.py --only room9_equirect,fountain-P11
-  scripts/benchmark_sfm.py --quick --no_stock   smaller renders, SPHERA only
+  scripts/benchmark_sfm.py --quick --no_upstream
+                                                smaller renders, SPHERA only
   scripts/benchmark_sfm.py --quick --repeats 3 --vary_seed
                                                 median and spread of 3 runs
-  scripts/benchmark_sfm.py --base 4 --quick     SPHERA on 4.x vs upstream 4.x
   scripts/benchmark_sfm.py --mapper_options "--Mapper.ba_sphere_residual PIXEL"
-                           --label pixel --no_stock   a second SPHERA setup,
-                                                      added to the same CSV
+                           --label pixel --no_upstream
+                                                a second SPHERA setup, added
+                                                to the same CSV
   scripts/benchmark_sfm.py --list               the data sets
 
 Data sets (rows):
@@ -30,37 +32,27 @@ Data sets (rows):
   entry-P10          Strecha, 10 perspective 3072x2048
   equirect_flat      11 real Ricoh Theta 5376x2688, no ground truth
 
-Bases (--base):
-  3.10 (default)  SPHERA build/bin/colmap, build/synthetic/sphera_render,
-                  output build/bench. Reference "stock": unpatched COLMAP 3.10
-                  (--stock_colmap, default build-stock/bin/colmap, built with
-                  scripts/build_stock.sh when missing, about 25 minutes). It
-                  knows PINHOLE only among these models, so it runs on the
-                  perspective sets (room_pinhole_ring, fountain-P11,
-                  entry-P10); the other sets have no stock row.
-  4               SPHERA build-4/bin/colmap, build-4/synthetic/sphera_render,
-                  output build-4/bench. Reference "upstream": unpatched
-                  upstream COLMAP 4.x at the same commit (--upstream_colmap,
-                  default ~/.cache/sphera-peers/colmap4/build/src/colmap/exe/
-                  colmap, built with ../shared/peers/build_colmap4.sh when
-                  missing, about 40 minutes). It knows EQUIRECTANGULAR and
-                  PINHOLE, so it runs on room9_equirect, room_poles,
-                  room_pinhole_ring, the Strecha sets and equirect_flat; the
-                  fisheye and hybrid sets get an upstream row "cannot: camera
-                  model UNIFIED_OMNI unknown to upstream". Command-line names
-                  of 4.x (--FeatureExtraction.*, --FeatureMatching.*).
+Programs: SPHERA build/bin/colmap and build/synthetic/sphera_render, output
+build/bench. Reference "upstream": unpatched upstream COLMAP 4.x at the same
+commit (--upstream_colmap, default ~/.cache/sphera-peers/colmap4/build/src/
+colmap/exe/colmap, built with ../shared/peers/build_colmap4.sh when missing,
+about 40 minutes). It knows EQUIRECTANGULAR and PINHOLE, so it runs on
+room9_equirect, room_poles, room_pinhole_ring, the Strecha sets and
+equirect_flat; the fisheye and hybrid sets get an upstream row "cannot:
+camera model UNIFIED_OMNI unknown to upstream". Both systems get the same
+command line (--FeatureExtraction.*, --FeatureMatching.*).
 SPHERA's program always does the evaluation (model_evaluator,
 model_analyzer) and the Strecha import (strecha_importer), whichever system
-reconstructed. --no_stock (or --no_reference) leaves the reference out.
+reconstructed. --no_upstream (or --no_reference) leaves the reference out.
 
 Repeats: with --repeats N every (data set, system) is reconstructed N times
 from the same rendered scene; the runs of SPHERA and of the reference
 alternate, so that load changes on the machine hit both. COLMAP seeds its
-random numbers with 0 in every command (3.10: --random_seed, 4.x:
---default_random_seed), so plain repeats differ only by thread scheduling:
-the errors hardly move and the times show the machine's noise. With
---vary_seed run k passes seed k-1 to every command of both systems (run 1 is
-the default run), so RANSAC differs from run to run. A system that failed
+random numbers with 0 in every command (--default_random_seed), so plain
+repeats differ only by thread scheduling: the errors hardly move and the
+times show the machine's noise. With --vary_seed run k passes seed k-1 to
+every command of both systems (run 1 is the default run), so RANSAC differs
+from run to run. A system that failed
 before its mapper ran (missing data or program, render, extraction or
 matching failed) is not repeated. The table and sfm_results.csv give the
 median over the successful runs of every number, and for the rotation and
@@ -81,9 +73,10 @@ Each run works in OUTPUT_DIR/runs/<dataset>/<system>/ (<system>/run<k>/ with
 every command's output). Results go to OUTPUT_DIR/sfm_results.csv (one row
 per data set and system), OUTPUT_DIR/runs.csv (one row per run) and
 OUTPUT_DIR/sfm_results.png; rows of earlier runs that this run did not redo
-are kept in both CSVs unless --fresh. Shared real data (../shared/data by
-default) may be absent: those rows are reported as skipped. A failing run
-is recorded in the `status` column and does not stop the benchmark.
+are kept in both CSVs unless --fresh (rows of another COLMAP base, from an
+older CSV, are dropped). Shared real data (../shared/data by default) may be
+absent: those rows are reported as skipped. A failing run is recorded in the
+`status` column and does not stop the benchmark.
 
 Needs Debian's python3 (python3-matplotlib for the PNG; without it the PNG
 is skipped with a note).
@@ -119,44 +112,28 @@ DATASET_MODELS = {
 }
 DATASETS = list(DATASET_MODELS)
 
-# The COLMAP base SPHERA is built on, and the unpatched reference of that
-# base. reference_models: the models the reference knows among those above;
-# cannot_rows: data sets with other models get an explicit "cannot" row of
-# the reference (3.10: left out, as the README's table has always done).
-BASES = {
-    "3.10": {
-        "build_dir": "build",
-        "build_hint": "scripts/build.sh",
-        "reference": "stock",
-        "reference_title": "stock COLMAP 3.10",
-        "reference_models": {"PINHOLE"},
-        "cannot_rows": False,
-        "reference_builder": os.path.join(REPO_ROOT, "scripts", "build_stock.sh"),
-        "reference_build_minutes": 25,
-        "extraction_gpu": "--SiftExtraction.use_gpu",
-        "seed_option": "--random_seed",
-        "matching_gpu": "--SiftMatching.use_gpu",
-    },
-    "4": {
-        "build_dir": "build-4",
-        "build_hint": "SPHERA_COLMAP_BASE=4 scripts/build.sh",
-        "reference": "upstream",
-        "reference_title": "upstream COLMAP 4.x",
-        "reference_models": {"PINHOLE", "EQUIRECTANGULAR"},
-        "cannot_rows": True,
-        "reference_builder": os.path.normpath(os.path.join(
-            REPO_ROOT, "..", "shared", "peers", "build_colmap4.sh")),
-        "reference_build_minutes": 40,
-        "extraction_gpu": "--FeatureExtraction.use_gpu",
-        "seed_option": "--default_random_seed",
-        "matching_gpu": "--FeatureMatching.use_gpu",
-    },
-}
-REFERENCE_SYSTEMS = {base["reference"] for base in BASES.values()}
+# The COLMAP base SPHERA is built on (the `base` column of the CSVs), and
+# the unpatched reference of that base: upstream COLMAP at the same commit.
+# REFERENCE_MODELS: the models the reference knows among those above; data
+# sets with other models get an explicit "cannot" row of the reference.
+BASE = "4"
+BUILD_DIR = os.path.join(REPO_ROOT, "build")
+BUILD_HINT = "scripts/build.sh"
+REFERENCE = "upstream"
+REFERENCE_TITLE = "upstream COLMAP 4.x"
+REFERENCE_MODELS = {"PINHOLE", "EQUIRECTANGULAR"}
+REFERENCE_BUILDER = os.path.normpath(os.path.join(
+    REPO_ROOT, "..", "shared", "peers", "build_colmap4.sh"))
+REFERENCE_BUILD_MINUTES = 40
+REFERENCE_SYSTEMS = {REFERENCE}
+UPSTREAM_COLMAP = os.path.join(os.path.expanduser("~"), ".cache", "sphera-peers",
+                               "colmap4", "build", "src", "colmap", "exe",
+                               "colmap")
+# Command-line names of COLMAP 4.x, the same for both systems.
+EXTRACTION_GPU = "--FeatureExtraction.use_gpu"
+MATCHING_GPU = "--FeatureMatching.use_gpu"
+SEED_OPTION = "--default_random_seed"
 DEFAULT_LABEL = "sphera"
-UPSTREAM_COLMAP4 = os.path.join(os.path.expanduser("~"), ".cache", "sphera-peers",
-                                "colmap4", "build", "src", "colmap", "exe",
-                                "colmap")
 
 # Numbers of a run, summarised over the repeats by their median; SPREAD_KEYS
 # also get <key>_min and <key>_max columns (the spread).
@@ -532,33 +509,29 @@ RENDERED = {
 # The benchmark
 
 
-def unknown_models(base, dataset):
-    """The camera models of `dataset` that the reference of `base` lacks."""
-    return [m for m in DATASET_MODELS[dataset]
-            if m not in base["reference_models"]]
+def unknown_models(dataset):
+    """The camera models of `dataset` that the reference lacks."""
+    return [m for m in DATASET_MODELS[dataset] if m not in REFERENCE_MODELS]
 
 
 class Benchmark:
     def __init__(self, args):
         """Programs and directories from the options; those left empty take
-        the defaults of args.base. Raises ValueError on --mapper_options
-        that do not split."""
+        the defaults in build/. Raises ValueError on --mapper_options that
+        do not split."""
         self.args = args
-        self.base = BASES[args.base]
-        build = os.path.join(REPO_ROOT, self.base["build_dir"])
         self.output_dir = os.path.abspath(args.output_dir
-                                          or os.path.join(build, "bench"))
+                                          or os.path.join(BUILD_DIR, "bench"))
         self.colmap = os.path.abspath(args.colmap
-                                      or os.path.join(build, "bin", "colmap"))
+                                      or os.path.join(BUILD_DIR, "bin", "colmap"))
         self.render = os.path.abspath(
-            args.render or os.path.join(build, "synthetic", "sphera_render"))
+            args.render or os.path.join(BUILD_DIR, "synthetic", "sphera_render"))
         self.data_dir = os.path.abspath(args.data_dir)
         self.supersample = 2 if args.quick else 3
         self.label = args.label
         self.mapper_options = shlex.split(args.mapper_options)
-        self.reference = self.base["reference"]
-        self.reference_colmap = os.path.abspath(
-            args.stock_colmap if self.reference == "stock" else args.upstream_colmap)
+        self.reference = REFERENCE
+        self.reference_colmap = os.path.abspath(args.upstream_colmap)
         self.reference_error = None  # set when the reference is unavailable
         self.reference_checked = False
 
@@ -581,8 +554,8 @@ class Benchmark:
         self.reference_checked = True
         if os.access(self.reference_colmap, os.X_OK):
             return None
-        title = self.base["reference_title"]
-        script = self.base["reference_builder"]
+        title = REFERENCE_TITLE
+        script = REFERENCE_BUILDER
         if not os.path.exists(script):
             folder = os.path.dirname(script)
             self.reference_error = "cannot build %s: %s" % (
@@ -591,7 +564,7 @@ class Benchmark:
             return self.reference_error
         log("%s missing (%s): building it with %s (about %d min)" %
             (title, self.reference_colmap, script,
-             self.base["reference_build_minutes"]))
+             REFERENCE_BUILD_MINUTES))
         try:
             _, output = run_step("build_" + self.reference, [script],
                                  os.path.join(self.output_dir, "logs"),
@@ -646,7 +619,7 @@ class Benchmark:
             return scene
         if not self.wait_for(self.render, "sphera_render"):
             raise StepError("sphera_render not found at %s (build with "
-                            "%s)" % (self.render, self.base["build_hint"]))
+                            "%s)" % (self.render, BUILD_HINT))
         shutil.rmtree(scene, ignore_errors=True)
         os.makedirs(os.path.dirname(scene), exist_ok=True)
         if rig_text is not None:
@@ -669,7 +642,7 @@ class Benchmark:
     def reconstruct(self, colmap, run_dir, image_path, groups, row,
                     mapper_options=(), seed=None):
         """feature_extractor per camera group, exhaustive_matcher, mapper
-        (with extra `mapper_options`) with the option names of the base;
+        (with extra `mapper_options`) with COLMAP 4.x's option names;
         every command with the random seed `seed` unless None (COLMAP's
         default seed is 0). groups: [(model, params or None, image list or
         None)]. Fills the times (t_total_s: their sum), num_models and
@@ -677,14 +650,14 @@ class Benchmark:
         logs = os.path.join(run_dir, "logs")
         database = os.path.join(run_dir, "database.db")
         timeout = self.args.step_timeout
-        seeded = [] if seed is None else [self.base["seed_option"], str(seed)]
+        seeded = [] if seed is None else [SEED_OPTION, str(seed)]
         t_extract = 0.0
         for index, (model, params, image_list) in enumerate(groups):
             command = [colmap, "feature_extractor", "--database_path", database,
                        "--image_path", image_path,
                        "--ImageReader.camera_model", model,
                        "--ImageReader.single_camera_per_folder", "1",
-                       self.base["extraction_gpu"], "0"] + seeded
+                       EXTRACTION_GPU, "0"] + seeded
             if params:
                 command += ["--ImageReader.camera_params",
                             ",".join(str(p) for p in params)]
@@ -703,7 +676,7 @@ class Benchmark:
         row["t_extract_s"] = round(t_extract, 3)
         seconds, _ = run_step("exhaustive_matcher",
                               [colmap, "exhaustive_matcher", "--database_path",
-                               database, self.base["matching_gpu"], "0"] + seeded,
+                               database, MATCHING_GPU, "0"] + seeded,
                               logs, timeout)
         row["t_match_s"] = round(seconds, 3)
         sparse = os.path.join(run_dir, "sparse")
@@ -842,7 +815,7 @@ class Benchmark:
         SPHERA label or the reference); returns the run's row."""
         is_reference = system == self.reference
         seed = repeat - 1 if self.args.vary_seed else None
-        row = {"dataset": dataset, "system": system, "base": self.args.base,
+        row = {"dataset": dataset, "system": system, "base": BASE,
                "repeat": repeat, "seed": "" if seed is None else seed,
                "status": "ok",
                "mapper_options": "" if is_reference
@@ -905,13 +878,13 @@ class Benchmark:
         per system including the reference's "cannot" row)."""
         systems = [self.label]
         cannot = []
-        unknown = unknown_models(self.base, dataset)
-        if not self.args.no_stock and not unknown:
+        unknown = unknown_models(dataset)
+        if not self.args.no_upstream and not unknown:
             systems.append(self.reference)
-        elif not self.args.no_stock and self.base["cannot_rows"]:
+        elif not self.args.no_upstream:
             cannot.append({
                 "dataset": dataset, "system": self.reference,
-                "base": self.args.base, "runs": 0, "runs_ok": 0,
+                "base": BASE, "runs": 0, "runs_ok": 0,
                 "status": "cannot: camera model %s unknown to %s" %
                           ("/".join(unknown), self.reference),
                 "timestamp": now()})
@@ -979,9 +952,8 @@ def summarize(runs):
 
 
 def row_key(row):
-    """(base, data set, system): rows of earlier runs without a base come
-    from the 3.10 base."""
-    return (row.get("base") or "3.10", row.get("dataset"), row.get("system"))
+    """(base, data set, system)."""
+    return (row.get("base") or "", row.get("dataset"), row.get("system"))
 
 
 def add_ratios(rows):
@@ -1092,16 +1064,20 @@ def read_csv(path):
 
 def merge_earlier(path, rows, fresh):
     """`rows` and, unless `fresh`, the rows of the CSV at `path` for other
-    (base, data set, system); returns them sorted, and the number kept."""
+    (data set, system) of this base; returns them sorted, and the number
+    kept. Rows of another COLMAP base (an older CSV) are dropped."""
     done = {row_key(r) for r in rows}
-    kept = [] if fresh else [r for r in read_csv(path) if row_key(r) not in done]
+    earlier = [] if fresh else read_csv(path)
+    kept = [r for r in earlier if r.get("base") == BASE and row_key(r) not in done]
+    dropped = sum(1 for r in earlier if r.get("base") != BASE)
+    if dropped:
+        log("%s: dropped %d row(s) of another COLMAP base" % (path, dropped))
     return sort_rows(rows + kept), len(kept)
 
 
 def system_title(system):
-    for base in BASES.values():
-        if base["reference"] == system:
-            return base["reference_title"]
+    if system == REFERENCE:
+        return REFERENCE_TITLE
     return "SPHERA" if system == DEFAULT_LABEL else "SPHERA " + system
 
 
@@ -1229,8 +1205,7 @@ def write_png(path, rows):
                    "n/a: no value (failed, skipped or cannot run)" %
                    ("/".join(map(str, runs)) or "1"),
                    fontsize=9, va="top", transform=legend_ax.transAxes)
-    bases = sorted({row_key(r)[0] for r in rows})
-    fig.suptitle("SPHERA SfM benchmark (COLMAP %s base)" % " and ".join(bases))
+    fig.suptitle("SPHERA SfM benchmark (COLMAP %s base)" % BASE)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -1240,9 +1215,6 @@ def write_png(path, rows):
 def make_parser():
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--base", choices=sorted(BASES), default="3.10",
-                        help="COLMAP base of SPHERA and of the reference "
-                             "(default %(default)s)")
     parser.add_argument("--only", default="",
                         help="comma-separated data sets (default: all)")
     parser.add_argument("--quick", action="store_true",
@@ -1252,25 +1224,25 @@ def make_parser():
     parser.add_argument("--vary_seed", action="store_true",
                         help="run k uses random seed k-1 (default: COLMAP's "
                              "fixed seed 0 in every run)")
-    parser.add_argument("--no_stock", "--no_reference", dest="no_stock",
+    parser.add_argument("--no_upstream", "--no_reference", dest="no_upstream",
                         action="store_true",
-                        help="no reference runs (stock or upstream; and no build)")
+                        help="no runs of upstream COLMAP (and no build of it)")
+    parser.add_argument("--no_stock", dest="no_upstream", action="store_true",
+                        help=argparse.SUPPRESS)  # its former name
     parser.add_argument("--mapper_options", default="",
                         help="extra options of SPHERA's mapper (not the "
                              "reference's), e.g. \"--Mapper.ba_sphere_residual PIXEL\"")
     parser.add_argument("--label", default=DEFAULT_LABEL,
                         help="system name of SPHERA's rows (default %(default)s)")
     parser.add_argument("--output_dir", default=None,
-                        help="default: <build dir of the base>/bench")
+                        help="default: build/bench")
     parser.add_argument("--colmap", default=None,
-                        help="SPHERA's program (default: <build dir>/bin/colmap)")
+                        help="SPHERA's program (default: build/bin/colmap)")
     parser.add_argument("--render", default=None,
-                        help="default: <build dir>/synthetic/sphera_render")
-    parser.add_argument("--stock_colmap",
-                        default=os.path.join(REPO_ROOT, "build-stock", "bin", "colmap"),
-                        help="reference of --base 3.10")
-    parser.add_argument("--upstream_colmap", default=UPSTREAM_COLMAP4,
-                        help="reference of --base 4 (default %(default)s)")
+                        help="default: build/synthetic/sphera_render")
+    parser.add_argument("--upstream_colmap", default=UPSTREAM_COLMAP,
+                        help="unpatched upstream COLMAP 4.x, the reference "
+                             "(default %(default)s)")
     parser.add_argument("--data_dir", default=os.path.join(REPO_ROOT, "..", "shared", "data"),
                         help="shared real data (strecha/, equirect_flat/)")
     parser.add_argument("--wait_minutes", type=float, default=0,
@@ -1300,7 +1272,7 @@ def main():
 
     if args.list:
         for name in DATASETS:
-            unknown = unknown_models(bench.base, name)
+            unknown = unknown_models(name)
             print(name + ("  (SPHERA and %s)" % bench.reference if not unknown else
                           "  (SPHERA only: %s unknown to %s)" %
                           ("/".join(unknown), bench.reference)))
@@ -1315,13 +1287,13 @@ def main():
     if not bench.wait_for(bench.colmap, "SPHERA colmap"):
         print("benchmark_sfm: %s not found; build it with %s "
               "(or pass --colmap, --wait_minutes)" %
-              (bench.colmap, bench.base["build_hint"]), file=sys.stderr)
+              (bench.colmap, BUILD_HINT), file=sys.stderr)
         return 1
     log("base %s: %s (label %s%s) against %s (%s)" % (
-        args.base, bench.colmap, bench.label,
+        BASE, bench.colmap, bench.label,
         ", mapper options " + args.mapper_options if args.mapper_options else "",
-        bench.base["reference_title"],
-        "not run" if args.no_stock else bench.reference_colmap))
+        REFERENCE_TITLE,
+        "not run" if args.no_upstream else bench.reference_colmap))
 
     try:
         commands = subprocess.run([bench.colmap, "help"], capture_output=True,

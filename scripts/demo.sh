@@ -49,9 +49,9 @@ database="${WORK_DIR}/database.db"
 start=$(date +%s)
 "${COLMAP}" feature_extractor --database_path "${database}" \
   --image_path "${image_dir}" --ImageReader.camera_model "${camera_model}" \
-  --ImageReader.single_camera_per_folder 1 --SiftExtraction.use_gpu 0
+  --ImageReader.single_camera_per_folder 1 --FeatureExtraction.use_gpu 0
 "${COLMAP}" exhaustive_matcher --database_path "${database}" \
-  --SiftMatching.use_gpu 0
+  --FeatureMatching.use_gpu 0
 mkdir -p "${WORK_DIR}/sparse"
 "${COLMAP}" mapper --database_path "${database}" --image_path "${image_dir}" \
   --output_path "${WORK_DIR}/sparse"
