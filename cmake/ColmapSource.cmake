@@ -17,11 +17,14 @@
 # SPHERA_PEERS_DIR (default: the folder shared/peers beside the repository,
 # when present) and in SPHERA_CACHE_DIR; each can also be given on its own
 # with SPHERA_COLMAP4_TARBALL, SPHERA_POSELIB_TARBALL and
-# SPHERA_FAISS_TARBALL. Every tarball is checked against its pinned SHA-256
-# before use, and a missing or damaged one stops the configuration with a
-# message naming the file and the expected checksum. Nothing is downloaded:
-# the build needs no network when the tarballs are present. The commit id
-# names the same source in COLMAP's public repository.
+# SPHERA_FAISS_TARBALL. A tarball found in SPHERA_PEERS_DIR is copied into
+# SPHERA_CACHE_DIR (default ~/.cache/sphera) when that does not hold it yet,
+# so that a later clone elsewhere on the machine finds it (a failed copy is
+# only reported). Every tarball is checked against its pinned SHA-256 before
+# use, and a missing or damaged one stops the configuration with a message
+# naming the file and the expected checksum. Nothing is downloaded: the build
+# needs no network when the tarballs are present. The commit id names the
+# same source in COLMAP's public repository.
 
 set(SPHERA_COLMAP_EDITABLE_DIR "" CACHE PATH
     "Editable patched COLMAP checkout, used as is")
@@ -68,9 +71,40 @@ function(sphera_verify_sha256 path expected what)
   endif()
 endfunction()
 
+# Copies the verified tarball `path` into SPHERA_CACHE_DIR, so that a later
+# clone elsewhere on this machine finds it without SPHERA_PEERS_DIR. The copy
+# goes to a temporary name, is checked and then renamed; any failure is only
+# reported, never stops the configuration.
+function(sphera_cache_tarball path name sha256)
+  set(cached "${SPHERA_CACHE_DIR}/${name}.tar.gz")
+  set(partial "${cached}.partial")
+  execute_process(COMMAND "${CMAKE_COMMAND}" -E make_directory "${SPHERA_CACHE_DIR}"
+                  OUTPUT_QUIET ERROR_QUIET)
+  execute_process(COMMAND "${CMAKE_COMMAND}" -E copy "${path}" "${partial}"
+                  RESULT_VARIABLE copy_result OUTPUT_QUIET ERROR_QUIET)
+  if(copy_result EQUAL 0 AND EXISTS "${partial}")
+    file(SHA256 "${partial}" copied_sha256)
+    if(copied_sha256 STREQUAL sha256)
+      execute_process(COMMAND "${CMAKE_COMMAND}" -E rename "${partial}" "${cached}"
+                      RESULT_VARIABLE copy_result OUTPUT_QUIET ERROR_QUIET)
+    else()
+      set(copy_result 1)
+    endif()
+  endif()
+  if(copy_result EQUAL 0)
+    message(STATUS "Copied ${name}.tar.gz into ${SPHERA_CACHE_DIR}")
+  else()
+    execute_process(COMMAND "${CMAKE_COMMAND}" -E rm -f "${partial}"
+                    OUTPUT_QUIET ERROR_QUIET)
+    message(STATUS "Could not copy ${path} into ${SPHERA_CACHE_DIR}; "
+                   "the build goes on with ${path}")
+  endif()
+endfunction()
+
 # Sets `out_var` to the tarball `name`.tar.gz: the cache variable `override`
 # when set, else the first of SPHERA_PEERS_DIR and SPHERA_CACHE_DIR holding it.
-# Verifies its SHA-256.
+# Verifies its SHA-256. A tarball found in SPHERA_PEERS_DIR is also copied into
+# SPHERA_CACHE_DIR when that does not hold it yet.
 function(sphera_find_tarball name sha256 override out_var)
   set(candidates "")
   if(${override})
@@ -85,6 +119,11 @@ function(sphera_find_tarball name sha256 override out_var)
   foreach(candidate ${candidates})
     if(EXISTS "${candidate}")
       sphera_verify_sha256("${candidate}" "${sha256}" "${name}")
+      if(NOT ${override} AND SPHERA_PEERS_DIR AND SPHERA_CACHE_DIR
+         AND candidate STREQUAL "${SPHERA_PEERS_DIR}/${name}.tar.gz"
+         AND NOT EXISTS "${SPHERA_CACHE_DIR}/${name}.tar.gz")
+        sphera_cache_tarball("${candidate}" "${name}" "${sha256}")
+      endif()
       set(${out_var} "${candidate}" PARENT_SCOPE)
       return()
     endif()
