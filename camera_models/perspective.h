@@ -1,4 +1,4 @@
-// COLMAP 3.10's PINHOLE (id 1) and OPENCV (id 4) models in the interface of
+// COLMAP's PINHOLE (id 1) and OPENCV (id 4) models in the interface of
 // this library, for the renderer and for tests that do not link COLMAP.
 // A ray is visible iff z > 0.
 #pragma once

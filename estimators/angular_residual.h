@@ -145,7 +145,7 @@ inline Eigen::Matrix3d QuaternionWXYZToRotationMatrix(const Eigen::Vector4d& q) 
 //
 // A point behind the ray (angle > 90 deg) simply has a large residual.
 // kEigenOrder = true takes q in Eigen's coefficient order [x, y, z, w]
-// (Eigen::Quaterniond::coeffs(), as COLMAP 3.10's Rigid3d stores it; use
+// (Eigen::Quaterniond::coeffs(), as COLMAP's Rigid3d stores it; use
 // ceres::EigenQuaternionManifold); see AngularReprojectionCostEigenQuat.
 template <bool kEigenOrder>
 class AngularReprojectionCostT {
@@ -191,7 +191,7 @@ class AngularReprojectionCostT {
 
 // Quaternion [w, x, y, z] (ceres convention, ceres::QuaternionManifold).
 using AngularReprojectionCost = AngularReprojectionCostT<false>;
-// Quaternion [x, y, z, w] (Eigen / COLMAP 3.10, ceres::EigenQuaternionManifold).
+// Quaternion [x, y, z, w] (Eigen / COLMAP, ceres::EigenQuaternionManifold).
 using AngularReprojectionCostEigenQuat = AngularReprojectionCostT<true>;
 
 // Same residual with a fixed camera (cam_from_world = [R | t]); only the
