@@ -140,7 +140,7 @@ endfunction()
 # ccache hits across clones) and consumed by COLMAP's FetchContent without a
 # network.
 function(sphera_prepare_colmap_dependencies)
-  set(deps_dir "${CMAKE_BINARY_DIR}/colmap-deps")
+  set(deps_dir "${CMAKE_BINARY_DIR}/colmap4-deps")
   foreach(dep POSELIB FAISS)
     set(name ${SPHERA_${dep}_NAME})
     set(source_dir "${deps_dir}/${name}")

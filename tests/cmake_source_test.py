@@ -31,7 +31,7 @@ class ColmapSourceTest(TempDirTestCase):
         self.assertIn(tarball, message)
         self.assertIn(COLMAP_SHA256, message)
         for leftover in ("build.ninja", "colmap-src", "colmap-stage",
-                         "colmap-deps"):
+                         "colmap4-deps"):
             self.assertFalse(os.path.exists(os.path.join(build_dir, leftover)),
                              leftover)
         return message
