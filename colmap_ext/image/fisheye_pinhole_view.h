@@ -15,9 +15,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
-
-#include <Eigen/Core>
 
 namespace colmap {
 
@@ -37,36 +34,25 @@ constexpr double kFisheyePinholeViewMaxNormalized = 1.7320508075688772;
 inline Camera FisheyePinholeView(const Camera& camera, double max_normalized) {
   const double cap =
       max_normalized > 0 ? max_normalized : kFisheyePinholeViewMaxNormalized;
-  // The fisheye's magnification at the principal point, pixels per unit of
-  // normalized coordinate, from its own projection.
-  constexpr double kStep = 1e-6;
-  const std::optional<Eigen::Vector2d> center =
-      camera.ImgFromCam(Eigen::Vector3d(0, 0, 1));
-  const std::optional<Eigen::Vector2d> along_x =
-      camera.ImgFromCam(Eigen::Vector3d(kStep, 0, 1));
-  const std::optional<Eigen::Vector2d> along_y =
-      camera.ImgFromCam(Eigen::Vector3d(0, kStep, 1));
-  double fx = camera.FocalLengthX();
-  double fy = camera.FocalLengthY();
-  if (center && along_x && along_y) {
-    fx = (along_x->x() - center->x()) / kStep;
-    fy = (along_y->y() - center->y()) / kStep;
-  }
+  // The fisheye's resolution at the principal point (pixels per radian, the
+  // inverse of the model's PixelToAngle in camera_models/), as
+  // sphere_undistorter's faces use it.
+  const double focal = 1.0 / camera.CamFromImgThreshold(1.0);
   const double cx = camera.PrincipalPointX();
   const double cy = camera.PrincipalPointY();
-  const double half_width =
-      std::max(cx, static_cast<double>(camera.width) - cx);
-  const double half_height =
-      std::max(cy, static_cast<double>(camera.height) - cy);
-  const double scale =
-      std::max({1.0, half_width / (cap * fx), half_height / (cap * fy)});
+  const double w = static_cast<double>(camera.width);
+  const double h = static_cast<double>(camera.height);
+  // Widened (a longer focal length) until the farthest image edge along an
+  // axis is within the cap.
+  const double view_focal =
+      std::max(focal, std::max({cx, w - cx, cy, h - cy}) / cap);
 
   Camera view;
   view.camera_id = camera.camera_id;
   view.model_id = PinholeCameraModel::model_id;
   view.width = camera.width;
   view.height = camera.height;
-  view.params = {scale * fx, scale * fy, cx, cy};
+  view.params = {view_focal, view_focal, cx, cy};
   return view;
 }
 
