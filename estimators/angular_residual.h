@@ -38,6 +38,7 @@
 // flips), and satisfies e1 x e2 = u.  Requires |u| = 1.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -114,6 +115,61 @@ inline Eigen::Vector2d AngularLogResidual(const Eigen::Vector3d& u,
   Eigen::Vector2d r;
   AngularLogResidual(u.data(), v.data(), r.data());
   return r;
+}
+
+// The same residual in doubles with its analytic Jacobian dr/dv (2 x 3,
+// row-major; nullptr skips it), u fixed.  With g = theta / s and
+// n2 = s^2 + c^2 = |v|^2:
+//
+//   dr/d(a, b, c) = [g + a^2 h,  a b h,      -a / n2]
+//                   [a b h,      g + b^2 h,  -b / n2],
+//   h = (c / n2 - g) / s^2,   dr/dv = dr/d(a, b, c) [e1; e2; u].
+//
+// h stays finite at s = 0: for x^2 = s^2 / c^2 < 1e-4 (c > 0) it is the
+// series (1 / c^3) sum_{k>=1} (-1)^k 2k / (2k + 1) x^(2k - 2), truncated
+// after x^6 like g itself.  At the antipode (s = 0, c <= 0) the residual is
+// (pi, 0) and the Jacobian zero, as the templated version gives.
+inline void AngularLogResidualWithJacobian(const double* u, const double* v,
+                                           double* residual,
+                                           double* dresidual_dv) {
+  double e1[3], e2[3];
+  RayTangentBasis(u, e1, e2);
+  const double a = e1[0] * v[0] + e1[1] * v[1] + e1[2] * v[2];
+  const double b = e2[0] * v[0] + e2[1] * v[1] + e2[2] * v[2];
+  const double c = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+  const double s2 = a * a + b * b;
+  double g, h;
+  if (c > 0 && s2 < 1e-4 * c * c) {
+    const double x2 = s2 / (c * c);
+    g = (1 - x2 * (1.0 / 3.0 - x2 * (1.0 / 5.0 - x2 * (1.0 / 7.0)))) / c;
+    h = (-2.0 / 3.0 + x2 * (4.0 / 5.0 - x2 * (6.0 / 7.0 - x2 * (8.0 / 9.0)))) /
+        (c * c * c);
+  } else if (s2 == 0) {
+    residual[0] = M_PI;
+    residual[1] = 0;
+    if (dresidual_dv != nullptr) {
+      std::fill(dresidual_dv, dresidual_dv + 6, 0.0);
+    }
+    return;
+  } else {
+    const double s = std::sqrt(s2);
+    g = std::atan2(s, c) / s;
+    h = (c / (s2 + c * c) - g) / s2;
+  }
+  residual[0] = g * a;
+  residual[1] = g * b;
+  if (dresidual_dv == nullptr) {
+    return;
+  }
+  const double n2 = s2 + c * c;
+  const double d[2][3] = {{g + a * a * h, a * b * h, -a / n2},
+                          {a * b * h, g + b * b * h, -b / n2}};
+  for (int row = 0; row < 2; ++row) {
+    for (int col = 0; col < 3; ++col) {
+      dresidual_dv[3 * row + col] =
+          d[row][0] * e1[col] + d[row][1] * e2[col] + d[row][2] * u[col];
+    }
+  }
 }
 
 // Geodesic angle between two (not necessarily unit) directions, in [0, pi]:

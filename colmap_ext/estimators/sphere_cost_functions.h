@@ -17,9 +17,15 @@
 //
 // Each functor below has the parameter blocks of the upstream pixel functor
 // of the same name without "Angular" (reprojection_error.h), so that
-// CreateSphereCameraCostFunction can put one in the other's place.
+// CreateSphereCameraCostFunction can put one in the other's place.  Where
+// upstream uses analytic Jacobians (the full and the constant-pose cost), so
+// do we: AngularReprojErrorCostFunction and
+// AngularReprojErrorConstantPoseCostFunction, tested against the autodiff
+// functors; mapping a 360-degree set with the angular residual then costs
+// no more than with the pixel one.
 #pragma once
 
+#include "colmap/estimators/cost_functions/quaternion_utils.h"
 #include "colmap/estimators/cost_functions/reprojection_error.h"
 #include "colmap/scene/camera.h"
 #include "colmap_ext/estimators/sphere_residual_type.h"
@@ -74,6 +80,183 @@ bool AngularReprojResidual(const T* camera_params,
     return true;
   }
 }
+
+// The same residual in doubles with analytic derivatives with respect to the
+// point in the camera frame (2 x 3, row-major) and, only when asked, to the
+// camera parameters (2 x num_params, by forward-mode differentiation of the
+// ray lifting alone); either Jacobian may be nullptr.  It equals
+// AngularReprojResidual: the same ray, the same log map.
+template <typename CameraModel>
+bool AngularReprojResidualWithJacobians(const double* camera_params,
+                                        const Eigen::Vector2d& observed_pixel,
+                                        const double* point3D_in_cam,
+                                        double* residuals,
+                                        double* J_point_in_cam,
+                                        double* J_params) {
+  using SphereModel = typename SphereMathOf<CameraModel>::type;
+  if constexpr (std::is_void_v<SphereModel>) {
+    return false;
+  } else {
+    constexpr int kNumParams = static_cast<int>(CameraModel::num_params);
+    const double pixels_per_radian =
+        1.0 / SphereModel::PixelToAngle(camera_params);
+    if (J_params == nullptr) {
+      const double pixel[2] = {observed_pixel.x(), observed_pixel.y()};
+      double observed_ray[3];
+      if (!SphereModel::RayFromImage(camera_params, pixel, observed_ray)) {
+        return false;
+      }
+      sphera::AngularLogResidualWithJacobian(
+          observed_ray, point3D_in_cam, residuals, J_point_in_cam);
+      residuals[0] *= pixels_per_radian;
+      residuals[1] *= pixels_per_radian;
+      if (J_point_in_cam != nullptr) {
+        for (int i = 0; i < 6; ++i) J_point_in_cam[i] *= pixels_per_radian;
+      }
+      return true;
+    }
+    // Derivatives: the camera parameters first, then the point.
+    using Jet = ceres::Jet<double, kNumParams + 3>;
+    Jet params[kNumParams];
+    for (int i = 0; i < kNumParams; ++i) {
+      params[i] = Jet(camera_params[i], i);
+    }
+    const Jet pixel[2] = {Jet(observed_pixel.x()), Jet(observed_pixel.y())};
+    Jet observed_ray[3];
+    if (!SphereModel::RayFromImage(params, pixel, observed_ray)) {
+      return false;
+    }
+    const Jet point[3] = {Jet(point3D_in_cam[0], kNumParams),
+                          Jet(point3D_in_cam[1], kNumParams + 1),
+                          Jet(point3D_in_cam[2], kNumParams + 2)};
+    Jet residual[2];
+    sphera::AngularLogResidual(observed_ray, point, residual);
+    for (int row = 0; row < 2; ++row) {
+      residuals[row] = residual[row].a * pixels_per_radian;
+      for (int i = 0; i < kNumParams; ++i) {
+        J_params[row * kNumParams + i] =
+            residual[row].v[i] * pixels_per_radian;
+      }
+      if (J_point_in_cam != nullptr) {
+        for (int k = 0; k < 3; ++k) {
+          J_point_in_cam[row * 3 + k] =
+              residual[row].v[kNumParams + k] * pixels_per_radian;
+        }
+      }
+    }
+    return true;
+  }
+}
+
+// AngularReprojErrorCostFunctor with analytic Jacobians: what bundle
+// adjustment uses for a spherical camera (upstream's analytic pixel cost
+// functions are its counterpart), the autodiff functor being the reference
+// it is tested against.
+template <typename CameraModel>
+class AngularReprojErrorCostFunction
+    : public ceres::SizedCostFunction<2, 3, 7, CameraModel::num_params> {
+ public:
+  explicit AngularReprojErrorCostFunction(const Eigen::Vector2d& point2D)
+      : point2D_(point2D) {}
+
+  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D) {
+    return new AngularReprojErrorCostFunction(point2D);
+  }
+
+  bool Evaluate(double const* const* parameters,
+                double* residuals,
+                double** jacobians) const override {
+    const double* point3D_in_world = parameters[0];
+    const double* cam_from_world = parameters[1];
+    double* J_point = jacobians ? jacobians[0] : nullptr;
+    double* J_pose = jacobians ? jacobians[1] : nullptr;
+    double* J_params = jacobians ? jacobians[2] : nullptr;
+
+    Eigen::Matrix<double, 3, 4, Eigen::RowMajor> J_rotated_quat;
+    const Eigen::Vector3d point3D_in_cam =
+        QuaternionRotatePointWithJac(cam_from_world,
+                                     point3D_in_world,
+                                     J_pose ? J_rotated_quat.data() : nullptr) +
+        Eigen::Map<const Eigen::Vector3d>(cam_from_world + 4);
+    Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J_in_cam;
+    if (!AngularReprojResidualWithJacobians<CameraModel>(
+            parameters[2],
+            point2D_,
+            point3D_in_cam.data(),
+            residuals,
+            (J_point || J_pose) ? J_in_cam.data() : nullptr,
+            J_params)) {
+      return false;
+    }
+    if (J_point) {
+      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> J_point_mat(
+          J_point);
+      J_point_mat =
+          J_in_cam *
+          EigenQuaternionMap<double>(cam_from_world).toRotationMatrix();
+    }
+    if (J_pose) {
+      Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> J_pose_mat(
+          J_pose);
+      J_pose_mat.leftCols<4>() = J_in_cam * J_rotated_quat;
+      J_pose_mat.rightCols<3>() = J_in_cam;
+    }
+    return true;
+  }
+
+ private:
+  const Eigen::Vector2d point2D_;
+};
+
+// AngularReprojErrorConstantPoseCostFunctor with analytic Jacobians.
+template <typename CameraModel>
+class AngularReprojErrorConstantPoseCostFunction
+    : public ceres::SizedCostFunction<2, 3, CameraModel::num_params> {
+ public:
+  AngularReprojErrorConstantPoseCostFunction(const Eigen::Vector2d& point2D,
+                                             const Rigid3d& cam_from_world)
+      : point2D_(point2D),
+        cam_from_world_rotation_(cam_from_world.rotation().toRotationMatrix()),
+        cam_from_world_translation_(cam_from_world.translation()) {}
+
+  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D,
+                                     const Rigid3d& cam_from_world) {
+    return new AngularReprojErrorConstantPoseCostFunction(point2D,
+                                                          cam_from_world);
+  }
+
+  bool Evaluate(double const* const* parameters,
+                double* residuals,
+                double** jacobians) const override {
+    double* J_point = jacobians ? jacobians[0] : nullptr;
+    double* J_params = jacobians ? jacobians[1] : nullptr;
+    const Eigen::Vector3d point3D_in_cam =
+        cam_from_world_rotation_ *
+            Eigen::Map<const Eigen::Vector3d>(parameters[0]) +
+        cam_from_world_translation_;
+    Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J_in_cam;
+    if (!AngularReprojResidualWithJacobians<CameraModel>(
+            parameters[1],
+            point2D_,
+            point3D_in_cam.data(),
+            residuals,
+            J_point ? J_in_cam.data() : nullptr,
+            J_params)) {
+      return false;
+    }
+    if (J_point) {
+      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> J_point_mat(
+          J_point);
+      J_point_mat = J_in_cam * cam_from_world_rotation_;
+    }
+    return true;
+  }
+
+ private:
+  const Eigen::Vector2d point2D_;
+  const Eigen::Matrix3d cam_from_world_rotation_;
+  const Eigen::Vector3d cam_from_world_translation_;
+};
 
 template <typename CameraModel>
 class AngularReprojErrorCostFunctor
@@ -221,18 +404,18 @@ class AngularRigReprojErrorConstantRigCostFunctor
   const AngularRigReprojErrorCostFunctor<CameraModel> reproj_cost_;
 };
 
-// The angular functor that takes the place of an upstream pixel functor.
+// The angular cost that takes the place of an upstream pixel functor.
 template <template <typename> class PixelFunctor>
 struct AngularFunctorOf;
 template <>
 struct AngularFunctorOf<ReprojErrorCostFunctor> {
   template <typename M>
-  using type = AngularReprojErrorCostFunctor<M>;
+  using type = AngularReprojErrorCostFunction<M>;
 };
 template <>
 struct AngularFunctorOf<ReprojErrorConstantPoseCostFunctor> {
   template <typename M>
-  using type = AngularReprojErrorConstantPoseCostFunctor<M>;
+  using type = AngularReprojErrorConstantPoseCostFunction<M>;
 };
 template <>
 struct AngularFunctorOf<ReprojErrorConstantPoint3DCostFunctor> {

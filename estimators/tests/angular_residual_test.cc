@@ -180,6 +180,54 @@ TEST(AngularResidual, JacobianFiniteAndCorrectAtZeroError) {
   }
 }
 
+// The double version with its analytic Jacobian gives the templated
+// residual and the Jet derivative within rounding, on both
+// sides of the small-angle series, near the antipode and at zero error.
+TEST(AngularResidual, AnalyticJacobianMatchesJets) {
+  std::mt19937 rng(5);
+  using Jet3 = ceres::Jet<double, 3>;
+  std::vector<double> angles = {0.0, 1e-9, 1e-5, 0.0099, 0.0101, 0.3, 1.5,
+                                2.5, 3.1};
+  int num_checked = 0;
+  for (const Eigen::Vector3d& u : TestRays(&rng)) {
+    for (double theta : angles) {
+      const Eigen::Vector3d w = test::RandomTangent(u, &rng);
+      const Eigen::Vector3d v =
+          0.7 * (std::cos(theta) * u + std::sin(theta) * w);
+      double r[2];
+      Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J;
+      AngularLogResidualWithJacobian(u.data(), v.data(), r, J.data());
+      const Jet3 u_jet[3] = {Jet3(u(0)), Jet3(u(1)), Jet3(u(2))};
+      const Jet3 v_jet[3] = {Jet3(v(0), 0), Jet3(v(1), 1), Jet3(v(2), 2)};
+      Jet3 r_jet[2];
+      AngularLogResidual(u_jet, v_jet, r_jet);
+      for (int row = 0; row < 2; ++row) {
+        EXPECT_NEAR(r[row], r_jet[row].a, 1e-15 * (1 + std::abs(r[row])));
+        for (int col = 0; col < 3; ++col) {
+          EXPECT_NEAR(J(row, col), r_jet[row].v[col],
+                      1e-9 * (1 + std::abs(r_jet[row].v[col])))
+              << "theta " << theta << " row " << row << " col " << col;
+        }
+      }
+      double r_only[2];
+      AngularLogResidualWithJacobian(u.data(), v.data(), r_only, nullptr);
+      EXPECT_EQ(r_only[0], r[0]);
+      EXPECT_EQ(r_only[1], r[1]);
+      ++num_checked;
+    }
+  }
+  EXPECT_EQ(num_checked, 49 * 9);
+  // Antipode: (pi, 0) and a zero Jacobian, as the templated version.
+  const Eigen::Vector3d u = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d v = -2 * u;
+  double r[2];
+  double J[6] = {1, 1, 1, 1, 1, 1};
+  AngularLogResidualWithJacobian(u.data(), v.data(), r, J);
+  EXPECT_EQ(r[0], M_PI);
+  EXPECT_EQ(r[1], 0);
+  for (double x : J) EXPECT_EQ(x, 0);
+}
+
 TEST(AngularResidual, EigenQuaternionOrderVariantAgrees) {
   std::mt19937 rng(5);
   for (int trial = 0; trial < 20; ++trial) {

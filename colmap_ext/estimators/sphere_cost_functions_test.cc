@@ -1,0 +1,234 @@
+// The analytic angular cost functions that bundle adjustment uses for
+// spherical cameras against the autodiff functors they replace: the same
+// residual, the same Jacobians for every parameter block (any subset asked
+// for), for points in front of, beside and behind each lens, at zero error,
+// and the same refusal of a pixel outside the image.
+#include "colmap_ext/estimators/sphere_cost_functions.h"
+
+#include "colmap/geometry/rigid3.h"
+#include "colmap/sensor/models.h"
+
+#include <cmath>
+#include <memory>
+#include <random>
+#include <typeinfo>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace colmap {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct CostCase {
+  std::string model;
+  std::vector<double> params;
+  int width;
+  int height;
+};
+
+std::vector<CostCase> CostCases() {
+  return {
+      {"EQUIRECTANGULAR", {2000, 1000}, 2000, 1000},
+      {"EUCM", {300, 310, 500, 400, 0.6, 1.1}, 1000, 800},
+      {"UNIFIED_OMNI",
+       {300, 310, 500, 400, 1.1, -0.02, 0.005, 0.0005, -0.0005},
+       1000,
+       800},
+      {"DOUBLE_SPHERE", {300, 310, 500, 400, -0.2, 0.6}, 1000, 800},
+  };
+}
+
+void PrintTo(const CostCase& cost_case, std::ostream* os) {
+  *os << cost_case.model;
+}
+
+// Evaluates `cost` at `parameters`, asking for the Jacobians of the blocks
+// whose bit is set in `mask`; the Jacobians of the other blocks stay empty.
+struct Evaluation {
+  bool ok = false;
+  double residuals[2] = {0, 0};
+  std::vector<std::vector<double>> jacobians;
+};
+
+Evaluation Evaluate(const ceres::CostFunction& cost,
+                    const std::vector<const double*>& parameters,
+                    int mask) {
+  Evaluation evaluation;
+  const std::vector<int32_t>& sizes = cost.parameter_block_sizes();
+  evaluation.jacobians.resize(sizes.size());
+  std::vector<double*> jacobians(sizes.size(), nullptr);
+  for (size_t i = 0; i < sizes.size(); ++i) {
+    if (mask & (1 << i)) {
+      evaluation.jacobians[i].assign(2 * sizes[i], 0.0);
+      jacobians[i] = evaluation.jacobians[i].data();
+    }
+  }
+  evaluation.ok = cost.Evaluate(
+      parameters.data(), evaluation.residuals, mask ? jacobians.data() : nullptr);
+  return evaluation;
+}
+
+void ExpectSameEvaluation(const Evaluation& analytic,
+                          const Evaluation& reference,
+                          const std::string& what) {
+  ASSERT_EQ(analytic.ok, reference.ok) << what;
+  if (!reference.ok) return;
+  for (int row = 0; row < 2; ++row) {
+    EXPECT_NEAR(analytic.residuals[row],
+                reference.residuals[row],
+                1e-9 * (1 + std::abs(reference.residuals[row])))
+        << what;
+  }
+  for (size_t block = 0; block < reference.jacobians.size(); ++block) {
+    ASSERT_EQ(analytic.jacobians[block].size(),
+              reference.jacobians[block].size());
+    for (size_t i = 0; i < reference.jacobians[block].size(); ++i) {
+      EXPECT_NEAR(analytic.jacobians[block][i],
+                  reference.jacobians[block][i],
+                  1e-7 * (1 + std::abs(reference.jacobians[block][i])))
+          << what << " block " << block << " entry " << i;
+    }
+  }
+}
+
+// Observations of random points at angles from the optical axis up to the
+// lens's reach (beyond 90 degrees: behind the image plane), each observed at
+// the projection of a slightly displaced point (non-zero residual) or at its
+// exact projection (zero residual).
+class SphereCostFunction : public ::testing::TestWithParam<CostCase> {
+ protected:
+  struct Observation {
+    Eigen::Vector2d pixel;
+    Eigen::Vector3d point3D;
+  };
+
+  std::vector<Observation> Observations(const Camera& camera,
+                                        const Rigid3d& cam_from_world,
+                                        std::mt19937* rng) const {
+    // Every third point beyond 90 degrees from the axis (up to 100 for the
+    // fisheye lenses, all around for the panorama).
+    const double max_angle =
+        camera.model_id == CameraModelId::kEquirectangular ? kPi
+                                                           : 100 * kPi / 180;
+    std::uniform_real_distribution<double> angle(0, max_angle);
+    std::uniform_real_distribution<double> behind_angle(kPi / 2, max_angle);
+    std::uniform_real_distribution<double> azimuth(-kPi, kPi);
+    std::uniform_real_distribution<double> depth(0.5, 20);
+    std::normal_distribution<double> noise(0, 0.02);
+    const Rigid3d world_from_cam = Inverse(cam_from_world);
+    std::vector<Observation> observations;
+    while (observations.size() < 60) {
+      const double a =
+          observations.size() % 3 == 1 ? behind_angle(*rng) : angle(*rng);
+      const double b = azimuth(*rng);
+      const Eigen::Vector3d ray(
+          std::sin(a) * std::cos(b), std::sin(a) * std::sin(b), std::cos(a));
+      const Eigen::Vector3d in_cam = depth(*rng) * ray;
+      const Eigen::Vector3d displaced =
+          observations.size() % 5 == 0
+              ? in_cam
+              : Eigen::Vector3d(in_cam + Eigen::Vector3d(noise(*rng),
+                                                         noise(*rng),
+                                                         noise(*rng)));
+      const std::optional<Eigen::Vector2d> pixel =
+          camera.ImgFromCam(displaced, /*check_cheirality=*/false);
+      if (!pixel || pixel->x() < 0 || pixel->y() < 0 ||
+          pixel->x() > camera.width || pixel->y() > camera.height) {
+        continue;
+      }
+      observations.push_back({*pixel, world_from_cam * in_cam});
+    }
+    return observations;
+  }
+
+  Camera MakeCamera() const {
+    const CostCase& cost_case = GetParam();
+    Camera camera;
+    camera.camera_id = 1;
+    camera.model_id = CameraModelNameToId(cost_case.model);
+    camera.params = cost_case.params;
+    camera.width = cost_case.width;
+    camera.height = cost_case.height;
+    return camera;
+  }
+};
+
+TEST_P(SphereCostFunction, AnalyticMatchesAutoDiff) {
+  const Camera camera = MakeCamera();
+  std::mt19937 rng(7);
+  const Rigid3d cam_from_world(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3)
+                                                    .normalized())),
+      Eigen::Vector3d(0.3, -1.2, 2.0));
+  int num_behind = 0;
+  for (const auto& observation : Observations(camera, cam_from_world, &rng)) {
+    num_behind += (cam_from_world * observation.point3D).z() < 0;
+    std::unique_ptr<ceres::CostFunction> analytic(
+        CreateSphereCameraCostFunction<ReprojErrorCostFunctor>(
+            SphereResidualType::ANGULAR, camera, observation.pixel));
+    std::unique_ptr<ceres::CostFunction> reference(
+        CreateCameraCostFunction<AngularReprojErrorCostFunctor>(
+            camera.model_id, observation.pixel));
+    EXPECT_NE(typeid(*analytic), typeid(*reference));
+    const std::vector<const double*> parameters = {
+        observation.point3D.data(),
+        cam_from_world.params.data(),
+        camera.params.data()};
+    for (int mask = 0; mask < 8; ++mask) {
+      ExpectSameEvaluation(Evaluate(*analytic, parameters, mask),
+                           Evaluate(*reference, parameters, mask),
+                           "full, mask " + std::to_string(mask));
+    }
+
+    std::unique_ptr<ceres::CostFunction> analytic_constant_pose(
+        CreateSphereCameraCostFunction<ReprojErrorConstantPoseCostFunctor>(
+            SphereResidualType::ANGULAR,
+            camera,
+            observation.pixel,
+            cam_from_world));
+    std::unique_ptr<ceres::CostFunction> reference_constant_pose(
+        CreateCameraCostFunction<AngularReprojErrorConstantPoseCostFunctor>(
+            camera.model_id, observation.pixel, cam_from_world));
+    const std::vector<const double*> constant_pose_parameters = {
+        observation.point3D.data(), camera.params.data()};
+    for (int mask = 0; mask < 4; ++mask) {
+      ExpectSameEvaluation(
+          Evaluate(*analytic_constant_pose, constant_pose_parameters, mask),
+          Evaluate(*reference_constant_pose, constant_pose_parameters, mask),
+          "constant pose, mask " + std::to_string(mask));
+    }
+  }
+  if (camera.model_id != CameraModelId::kEquirectangular) {
+    EXPECT_GT(num_behind, 5) << "no rays behind the image plane were tested";
+  }
+}
+
+TEST_P(SphereCostFunction, PixelOutsideTheImageIsRefusedLikeAutoDiff) {
+  const Camera camera = MakeCamera();
+  const Eigen::Vector2d outside(-5.0, camera.height + 5.0);
+  const Eigen::Vector3d point3D(0.1, 0.2, 3.0);
+  const Rigid3d cam_from_world;
+  std::unique_ptr<ceres::CostFunction> analytic(
+      CreateSphereCameraCostFunction<ReprojErrorCostFunctor>(
+          SphereResidualType::ANGULAR, camera, outside));
+  std::unique_ptr<ceres::CostFunction> reference(
+      CreateCameraCostFunction<AngularReprojErrorCostFunctor>(camera.model_id,
+                                                              outside));
+  const std::vector<const double*> parameters = {
+      point3D.data(), cam_from_world.params.data(), camera.params.data()};
+  const Evaluation analytic_evaluation = Evaluate(*analytic, parameters, 7);
+  const Evaluation reference_evaluation = Evaluate(*reference, parameters, 7);
+  EXPECT_EQ(analytic_evaluation.ok, reference_evaluation.ok);
+  if (camera.model_id == CameraModelId::kEquirectangular) {
+    EXPECT_FALSE(analytic_evaluation.ok);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(SphereModels,
+                         SphereCostFunction,
+                         ::testing::ValuesIn(CostCases()));
+
+}  // namespace
+}  // namespace colmap
