@@ -55,7 +55,8 @@ class MapperBAOptionsTest(TempDirTestCase):
         os.makedirs(output)
         run_colmap("model_evaluator", "--gt_path",
                    os.path.join(self.scene, "sparse_gt"), "--input_path",
-                   model, "--output_path", output)
+                   model, "--output_path", output,
+                   "--alignment", "orientations")
         with open(os.path.join(output, "evaluation.json")) as f:
             return json.load(f)
 

@@ -4,8 +4,9 @@ import json
 import math
 import os
 import random
+import shutil
 
-from cli_util import SHARED_DATA, TempDirTestCase, run_colmap
+from cli_util import SHARED_DATA, TempDirTestCase, pose_errors, run_colmap
 
 import unittest
 
@@ -56,6 +57,18 @@ def write_model(path, poses, model_line="EQUIRECTANGULAR 2048 1024 2048 1024"):
     open(os.path.join(path, "points3D.txt"), "w").close()
 
 
+FOUNTAIN = os.path.join(SHARED_DATA, "strecha", "fountain-P11")
+
+
+def import_fountain(output_path, *options):
+    """The Strecha fountain's ground-truth cameras as a model at
+    OUTPUT_PATH."""
+    os.makedirs(output_path)
+    run_colmap("strecha_importer", "--input_path",
+               os.path.join(FOUNTAIN, "gt_dense_cameras"), "--output_path",
+               output_path, *options)
+
+
 def ground_truth_poses(count=9, seed=3):
     rng = random.Random(seed)
     poses = []
@@ -68,12 +81,29 @@ def ground_truth_poses(count=9, seed=3):
     return poses
 
 
+def transformed(poses, scale, q_sim, t_sim, center_offsets=None):
+    """POSES seen in the world x' = scale q_sim x + t_sim, the centre of
+    image i first moved by center_offsets[i] (ground-truth units)."""
+    center_offsets = center_offsets or {}
+    estimate = []
+    for i, pose in enumerate(poses):
+        offset = center_offsets.get(i, (0.0, 0.0, 0.0))
+        center = tuple(c + o for c, o in zip(pose.center(), offset))
+        new_center = tuple(scale * c + t for c, t in
+                           zip(quat_rotate(q_sim, center), t_sim))
+        q_world = quat_mul(pose.q, (q_sim[0], -q_sim[1], -q_sim[2],
+                                    -q_sim[3]))
+        estimate.append(Pose.from_center(q_world, new_center))
+    return estimate
+
+
 class ModelEvaluatorTest(TempDirTestCase):
-    def evaluate(self, gt, estimate, check=True):
+    def evaluate(self, gt, estimate, check=True, alignment=None):
         os.makedirs(self.path("out"), exist_ok=True)
+        extra = ["--alignment", alignment] if alignment else []
         return run_colmap("model_evaluator", "--gt_path", gt, "--input_path",
                           estimate, "--output_path", self.path("out"),
-                          check=check)
+                          *extra, check=check)
 
     def read_json(self):
         with open(self.path("out", "evaluation.json")) as f:
@@ -96,39 +126,102 @@ class ModelEvaluatorTest(TempDirTestCase):
         # known rotation of one camera and a known centre offset of another.
         scale = 2.5
         q_sim = axis_angle_quat((0.3, -1, 0.2), 0.8)
-        t_sim = (4.0, -2.0, 1.5)
         rotation_error_deg = 0.5
         offset = 0.02  # ground-truth units
-        estimate = []
-        for i, pose in enumerate(gt):
-            center = pose.center()
-            if i == 4:
-                center = (center[0] + offset, center[1], center[2])
-            new_center = tuple(scale * c + t for c, t in
-                               zip(quat_rotate(q_sim, center), t_sim))
-            q_world = quat_mul(pose.q, (q_sim[0], -q_sim[1], -q_sim[2],
-                                        -q_sim[3]))
-            if i == 7:
-                q_world = quat_mul(axis_angle_quat(
-                    (0, 1, 0), math.radians(rotation_error_deg)), q_world)
-            estimate.append(Pose.from_center(q_world, new_center))
+        estimate = transformed(gt, scale, q_sim, (4.0, -2.0, 1.5),
+                               {4: (offset, 0.0, 0.0)})
+        estimate[7] = Pose.from_center(
+            quat_mul(axis_angle_quat((0, 1, 0),
+                                     math.radians(rotation_error_deg)),
+                     estimate[7].q),
+            estimate[7].center())
         write_model(self.path("estimate"), estimate)
-        self.evaluate(self.path("gt"), self.path("estimate"))
-        result = self.read_json()
-        self.assertEqual(result["num_registered"], 9)
-        by_name = {image["name"]: image for image in result["images"]}
-        self.assertAlmostEqual(by_name["view7.jpg"]["rotation_error_deg"],
-                               rotation_error_deg, delta=1e-6)
-        for name, image in by_name.items():
-            if name != "view7.jpg":
-                self.assertLess(image["rotation_error_deg"], 1e-6, name)
-        # The least-squares similarity spreads the offset of the camera at the
-        # centroid over all nine (its rotation and, to first order, its scale
-        # are unaffected): that camera keeps 8/9 of it, every other 1/9.
-        self.assertAlmostEqual(by_name["view4.jpg"]["position_error"],
-                               offset * 8 / 9, delta=2e-4)
-        self.assertAlmostEqual(by_name["view0.jpg"]["position_error"],
-                               offset / 9, delta=2e-4)
+        # Both protocols: the offset of the camera at the centroid changes
+        # neither the centres' rotation nor the orientations' median.
+        for alignment in ("centers", "orientations", None):
+            with self.subTest(alignment=alignment):
+                self.evaluate(self.path("gt"), self.path("estimate"),
+                              alignment=alignment)
+                result = self.read_json()
+                self.assertEqual(result["alignment"],
+                                 alignment or "centers")
+                self.assertEqual(result["num_registered"], 9)
+                by_name = {image["name"]: image
+                           for image in result["images"]}
+                self.assertAlmostEqual(
+                    by_name["view7.jpg"]["rotation_error_deg"],
+                    rotation_error_deg, delta=1e-6)
+                for name, image in by_name.items():
+                    if name != "view7.jpg":
+                        self.assertLess(image["rotation_error_deg"], 1e-6,
+                                        name)
+                # The least-squares similarity spreads the offset of the
+                # camera at the centroid over all nine (its rotation and, to
+                # first order, its scale are unaffected): that camera keeps
+                # 8/9 of it, every other 1/9.
+                self.assertAlmostEqual(by_name["view4.jpg"]["position_error"],
+                                       offset * 8 / 9, delta=2e-4)
+                self.assertAlmostEqual(by_name["view0.jpg"]["position_error"],
+                                       offset / 9, delta=2e-4)
+
+    def test_protocols_differ_as_predicted(self):
+        # Centre offsets off the centroid tilt the least-squares similarity
+        # of the centres, so under "centers" every camera shows the same
+        # rotation error, which an independent Umeyama alignment predicts;
+        # under "orientations" the (exact) orientations fix the rotation:
+        # no rotation error, positions from least squares with the true
+        # rotation.
+        import numpy as np
+        gt = ground_truth_poses()
+        write_model(self.path("gt"), gt)
+        q_sim = axis_angle_quat((1, 0.5, -0.2), 0.4)
+        t_sim = (1.0, 2.0, -3.0)
+        offsets = {0: (0.0, 0.06, 0.0), 2: (0.0, -0.04, 0.03),
+                   8: (0.05, 0.0, -0.02)}
+        write_model(self.path("estimate"),
+                    transformed(gt, 1.7, q_sim, t_sim, offsets))
+
+        self.evaluate(self.path("gt"), self.path("estimate"),
+                      alignment="centers")
+        centers = {image["name"]: image
+                   for image in self.read_json()["images"]}
+        expected = pose_errors(self.path("gt"), self.path("estimate"))
+        self.assertEqual(set(centers), set(expected))
+        tilt = max(rotation for rotation, _ in expected.values())
+        self.assertGreater(tilt, 0.1)  # degrees: the protocols must differ
+        for name, (rotation, position) in expected.items():
+            self.assertAlmostEqual(centers[name]["rotation_error_deg"],
+                                   rotation, delta=0.01 * rotation + 1e-9)
+            self.assertAlmostEqual(centers[name]["position_error"], position,
+                                   delta=0.01 * position + 1e-9)
+
+        self.evaluate(self.path("gt"), self.path("estimate"),
+                      alignment="ORIENTATIONS")
+        orientations = {image["name"]: image
+                        for image in self.read_json()["images"]}
+        gt_centres = np.array([pose.center() for pose in gt])
+        est = transformed(gt, 1.7, q_sim, t_sim, offsets)
+        # Undo the known world rotation, then least-squares scale and shift.
+        q_inv = (q_sim[0], -q_sim[1], -q_sim[2], -q_sim[3])
+        est_centres = np.array([quat_rotate(q_inv, pose.center())
+                                for pose in est])
+        g = gt_centres - gt_centres.mean(0)
+        e = est_centres - est_centres.mean(0)
+        scale = (g * e).sum() / (e * e).sum()
+        for i in range(len(gt)):
+            name = f"view{i}.jpg"
+            self.assertLess(orientations[name]["rotation_error_deg"], 1e-6)
+            self.assertAlmostEqual(orientations[name]["position_error"],
+                                   float(np.linalg.norm(scale * e[i] - g[i])),
+                                   delta=1e-7)
+
+    def test_unknown_alignment_is_named(self):
+        write_model(self.path("gt"), ground_truth_poses())
+        result = self.evaluate(self.path("gt"), self.path("gt"), check=False,
+                               alignment="median")
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("alignment", result.stdout)
+        self.assertFalse(os.path.exists(self.path("out", "evaluation.json")))
 
     def test_unregistered_images_are_counted(self):
         gt = ground_truth_poses()
@@ -161,6 +254,53 @@ class ModelEvaluatorTest(TempDirTestCase):
         self.assertNotEqual(result.returncode, 0)
         self.assertIn(self.path("estimate"), result.stdout)
         self.assertFalse(os.path.exists(self.path("out", "evaluation.json")))
+
+    @unittest.skipUnless(os.path.isdir(FOUNTAIN), "needs ../shared/data")
+    def test_centers_protocol_is_the_least_squares_similarity(self):
+        # The Strecha fountain's ground truth, each camera moved by noise
+        # (centres 2 cm, orientations 0.1 degrees) and the world by a
+        # similarity: "centers" measures what an independent least-squares
+        # similarity of the centres (Umeyama) gives, within 1%.
+        import_fountain(self.path("gt"), "--output_type", "TXT")
+        rng = random.Random(11)
+        q_sim = axis_angle_quat((0.2, 1, -0.4), 1.1)
+        t_sim = (3.0, 0.5, -7.0)
+        with open(self.path("gt", "images.txt")) as f:
+            lines = [l.split() for l in f
+                     if not l.startswith("#") and len(l.split()) == 10]
+        self.assertEqual(len(lines), 11)
+        estimate = []
+        for fields in lines:
+            pose = Pose(tuple(map(float, fields[1:5])),
+                        tuple(map(float, fields[5:8])))
+            noisy = Pose.from_center(
+                quat_mul(axis_angle_quat(
+                    (rng.gauss(0, 1), rng.gauss(0, 1), rng.gauss(0, 1)),
+                    math.radians(0.1)), pose.q),
+                tuple(c + rng.gauss(0, 0.02) for c in pose.center()))
+            moved = transformed([noisy], 0.3, q_sim, t_sim)[0]
+            estimate.append((fields[0], moved, fields[8], fields[9]))
+        os.makedirs(self.path("estimate"))
+        for name in ("cameras.txt", "points3D.txt"):
+            shutil.copy(self.path("gt", name), self.path("estimate", name))
+        with open(self.path("estimate", "images.txt"), "w") as f:
+            for image_id, pose, camera_id, name in estimate:
+                f.write(f"{image_id} {' '.join(map(repr, pose.q))} "
+                        f"{' '.join(map(repr, pose.t))} {camera_id} {name}"
+                        "\n\n")
+        os.makedirs(self.path("out"))
+        run_colmap("model_evaluator", "--gt_path", self.path("gt"),
+                   "--input_path", self.path("estimate"), "--output_path",
+                   self.path("out"), "--alignment", "centers")
+        measured = {image["name"]: image for image in self.read_json()["images"]}
+        expected = pose_errors(self.path("gt"), self.path("estimate"))
+        self.assertEqual(len(expected), 11)
+        for name, (rotation, position) in expected.items():
+            self.assertGreater(position, 1e-3, name)  # the noise is measured
+            self.assertAlmostEqual(measured[name]["rotation_error_deg"],
+                                   rotation, delta=0.01 * rotation)
+            self.assertAlmostEqual(measured[name]["position_error"], position,
+                                   delta=0.01 * position)
 
 
 class StrechaImporterTest(TempDirTestCase):
@@ -202,14 +342,9 @@ class StrechaImporterTest(TempDirTestCase):
         self.assertNotEqual(result.returncode, 0)
         self.assertIn("bad.jpg.camera:2", result.stdout)
 
-    @unittest.skipUnless(os.path.isdir(os.path.join(
-        SHARED_DATA, "strecha", "fountain-P11")), "needs ../shared/data")
+    @unittest.skipUnless(os.path.isdir(FOUNTAIN), "needs ../shared/data")
     def test_fountain_ground_truth_imports(self):
-        os.makedirs(self.path("model"))
-        run_colmap("strecha_importer", "--input_path",
-                   os.path.join(SHARED_DATA, "strecha", "fountain-P11",
-                                "gt_dense_cameras"),
-                   "--output_path", self.path("model"))
+        import_fountain(self.path("model"))
         with open(self.path("model", "images.txt")) as f:
             names = [l.split()[9] for l in f
                      if not l.startswith("#") and len(l.split()) == 10]

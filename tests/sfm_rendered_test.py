@@ -65,7 +65,10 @@ class RenderedSfMTest(TempDirTestCase):
                    os.path.join(scene, "sparse_gt"), "--input_path",
                    self.path("sparse", "0"), "--depth_path",
                    os.path.join(scene, "depth"), "--output_path",
-                   self.path("eval"))
+                   self.path("eval"),
+                   # The thresholds below hold for the rotation taken from
+                   # the camera orientations.
+                   "--alignment", "orientations")
         with open(self.path("eval", "evaluation.json")) as f:
             return json.load(f)
 

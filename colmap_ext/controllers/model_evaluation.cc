@@ -1,6 +1,7 @@
 #include "colmap_ext/controllers/model_evaluation.h"
 
 #include "colmap/estimators/alignment.h"
+#include "colmap/estimators/solvers/similarity_transform.h"
 #include "colmap/geometry/pose.h"
 #include "colmap/math/math.h"
 #include "colmap/util/logging.h"
@@ -174,9 +175,7 @@ ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
         std::to_string(max_proj_center_error) + " (ground-truth units)");
   }
 
-  // Refine: rotation from the camera orientations (geodesic median, robust to
-  // a minority of wrong cameras), scale and translation from the centres that
-  // the robust centre alignment kept.
+  // Refine on the centres that the robust alignment kept.
   std::vector<Eigen::Matrix3d> world_rotations;
   std::vector<Eigen::Vector3d> inlier_centers;
   std::vector<Eigen::Vector3d> inlier_gt_centers;
@@ -193,19 +192,33 @@ ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
       inlier_gt_centers.push_back(gt_image.ProjectionCenter());
     }
   }
-  const Eigen::Matrix3d gt_from_reconstruction_rotation =
-      sphera::GeodesicMedianRotation(world_rotations);
-  double scale = 0;
-  Eigen::Vector3d translation;
-  if (sphera::AlignCentersWithRotation(inlier_centers,
-                                       inlier_gt_centers,
-                                       gt_from_reconstruction_rotation,
-                                       &scale,
-                                       &translation)) {
-    gt_from_reconstruction =
-        Sim3d(scale,
-              Eigen::Quaterniond(gt_from_reconstruction_rotation),
-              translation);
+  evaluation.alignment = options.alignment;
+  switch (options.alignment) {
+    case ModelAlignment::CENTERS: {
+      Sim3d least_squares;
+      if (EstimateSim3d(inlier_centers, inlier_gt_centers, least_squares)) {
+        gt_from_reconstruction = least_squares;
+      }
+      break;
+    }
+    case ModelAlignment::ORIENTATIONS: {
+      // The geodesic median is robust to a minority of wrong cameras.
+      const Eigen::Matrix3d gt_from_reconstruction_rotation =
+          sphera::GeodesicMedianRotation(world_rotations);
+      double scale = 0;
+      Eigen::Vector3d translation;
+      if (sphera::AlignCentersWithRotation(inlier_centers,
+                                           inlier_gt_centers,
+                                           gt_from_reconstruction_rotation,
+                                           &scale,
+                                           &translation)) {
+        gt_from_reconstruction =
+            Sim3d(scale,
+                  Eigen::Quaterniond(gt_from_reconstruction_rotation),
+                  translation);
+      }
+      break;
+    }
   }
 
   evaluation.closest_pair_baseline = ClosestPairBaseline(ground_truth);
@@ -333,9 +346,17 @@ ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
   return evaluation;
 }
 
+std::string AlignmentName(ModelAlignment alignment) {
+  std::string name(ModelAlignmentToString(alignment));
+  StringToLower(&name);
+  return name;
+}
+
 std::string ModelEvaluationToJson(const ModelEvaluation& e) {
   std::ostringstream json;
   json << "{\n"
+       << "  \"alignment\": " << JsonString(AlignmentName(e.alignment))
+       << ",\n"
        << "  \"num_gt_images\": " << e.num_gt_images << ",\n"
        << "  \"num_registered\": " << e.num_registered << ",\n"
        << "  \"num_points3D\": " << e.num_points3D << ",\n"

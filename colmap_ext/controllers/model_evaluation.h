@@ -4,13 +4,25 @@
 #pragma once
 
 #include "colmap/scene/reconstruction.h"
+#include "colmap/util/enum_utils.h"
 
 #include <string>
 #include <vector>
 
 namespace colmap {
 
+// How the reconstruction is aligned to the ground truth before its pose errors
+// are measured. Both start from a robust similarity on the camera centres
+// (RANSAC, inliers within max_proj_center_error), then refine on its inliers:
+//   CENTERS       least-squares similarity of the inlier centres (Umeyama
+//                 1991), as the SPHERA paper and most published evaluations;
+//   ORIENTATIONS  rotation from the camera orientations (geodesic median of
+//                 R_gt^T R), scale and translation by least squares on the
+//                 inlier centres with that rotation.
+MAKE_ENUM_CLASS_OVERLOAD_STREAM(ModelAlignment, 0, CENTERS, ORIENTATIONS);
+
 struct ModelEvaluationOptions {
+  ModelAlignment alignment = ModelAlignment::CENTERS;
   // Inlier threshold of the robust similarity on camera centres, in ground
   // truth units; <= 0 picks 5% of the largest distance between ground-truth
   // camera centres.
@@ -37,6 +49,7 @@ struct CameraEvaluation {
 };
 
 struct ModelEvaluation {
+  ModelAlignment alignment = ModelAlignment::CENTERS;
   size_t num_gt_images = 0;
   size_t num_registered = 0;
   size_t num_points3D = 0;
@@ -58,14 +71,16 @@ struct ModelEvaluation {
   std::vector<CameraEvaluation> cameras;
 };
 
-// Aligns `reconstruction` to `ground_truth` by a robust similarity on camera
-// centres (no reprojection involved, so any camera model works), refined with
-// its rotation taken from the camera orientations
-// (estimators/similarity_alignment.h), and measures the errors. Throws std::invalid_argument with a message when the models
-// cannot be compared (fewer than 3 common registered images, no alignment).
+// Aligns `reconstruction` to `ground_truth` as options.alignment says (no
+// reprojection involved, so any camera model works) and measures the errors.
+// Throws std::invalid_argument with a message when the models cannot be
+// compared (fewer than 3 common registered images, no alignment).
 ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
                               const Reconstruction& reconstruction,
                               const ModelEvaluationOptions& options);
+
+// "centers" or "orientations", as the command line and the outputs name it.
+std::string AlignmentName(ModelAlignment alignment);
 
 std::string ModelEvaluationToJson(const ModelEvaluation& evaluation);
 

@@ -47,7 +47,16 @@ int RunModelEvaluator(int argc, char** argv) {
   options.AddDefaultOption("depth_path", &evaluation_options.depth_path);
   options.AddDefaultOption("max_proj_center_error",
                            &evaluation_options.max_proj_center_error);
-  options.Parse(argc, argv);
+  options.AddDefaultEnumOption("alignment",
+                               &evaluation_options.alignment,
+                               ModelAlignmentToString,
+                               ModelAlignmentFromString,
+                               "centers: least-squares similarity of the "
+                               "camera centres; orientations: rotation from "
+                               "the camera orientations");
+  if (!options.Parse(argc, argv)) {
+    return EXIT_FAILURE;
+  }
 
   for (const auto& [name, path] :
        {std::make_pair("gt_path", gt_path),
@@ -99,7 +108,9 @@ int RunModelEvaluator(int argc, char** argv) {
     }
     table << "\n";
   }
-  table << std::setprecision(6) << "registered: " << evaluation.num_registered
+  table << std::setprecision(6)
+        << "alignment: " << AlignmentName(evaluation.alignment)
+        << "\nregistered: " << evaluation.num_registered
         << "/" << evaluation.num_gt_images
         << "\nrotation error (deg): mean " << evaluation.mean_rotation_error_deg
         << " max " << evaluation.max_rotation_error_deg
