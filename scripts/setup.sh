@@ -20,7 +20,7 @@ readonly PACKAGES=(
   # SPHERA: bearing-vector solvers, image remapping
   libopengv-dev libopencv-dev
   # tests, benchmarks and plots
-  python3 python3-numpy python3-matplotlib sqlite3
+  python3 python3-numpy python3-scipy python3-matplotlib sqlite3
 )
 
 missing=()
