@@ -4,9 +4,9 @@ the repository: the test is skipped without it)."""
 import os
 import unittest
 
-from cli_util import (CPU_EXTRACTION, CPU_MATCHING, SHARED_DATA, Database,
-                      TempDirTestCase, analyze_model, main_with_skip,
-                      run_colmap)
+from cli_util import SHARED_DATA, Database, TempDirTestCase, main_with_skip
+from sphera_common import (CPU_EXTRACTION, CPU_MATCHING, analyze_model,
+                           run_colmap)
 
 IMAGES = os.path.join(SHARED_DATA, "equirect_flat", "images")
 

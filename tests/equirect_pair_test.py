@@ -5,9 +5,9 @@ on the sphere and reconstructed by the mapper from that pair alone."""
 import os
 import unittest
 
-from cli_util import (CPU_EXTRACTION, CPU_MATCHING, SHARED_DATA, Database,
-                      TempDirTestCase, analyze_model, main_with_skip,
-                      run_colmap)
+from cli_util import SHARED_DATA, Database, TempDirTestCase, main_with_skip
+from sphera_common import (CPU_EXTRACTION, CPU_MATCHING, analyze_model,
+                           run_colmap)
 
 IMAGES = os.path.join(SHARED_DATA, "equirect_pair")
 

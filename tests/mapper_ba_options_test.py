@@ -9,14 +9,11 @@ import json
 import os
 import re
 import shutil
-import subprocess
 import tempfile
-import unittest
 
-from cli_util import (CPU_EXTRACTION, CPU_MATCHING, TempDirTestCase,
-                      read_text_model, run_colmap)
-
-RENDER = os.environ.get("SPHERA_RENDER", "")
+from cli_util import TempDirTestCase, main_with_render
+from sphera_common import (CPU_EXTRACTION, CPU_MATCHING, model_to_text,
+                           read_text_model, run_colmap, run_render)
 
 
 class MapperBAOptionsTest(TempDirTestCase):
@@ -24,10 +21,9 @@ class MapperBAOptionsTest(TempDirTestCase):
     def setUpClass(cls):
         cls.shared = tempfile.mkdtemp(prefix="sphera_test_")
         cls.scene = os.path.join(cls.shared, "scene")
-        subprocess.run([RENDER, "--output", cls.scene, "--layout", "room9",
-                        "--model", "EQUIRECTANGULAR", "--width", "1024",
-                        "--height", "512", "--supersample", "2", "--seed",
-                        "11"], check=True, stdout=subprocess.DEVNULL)
+        run_render(cls.scene, "--layout", "room9", "--model",
+                   "EQUIRECTANGULAR", "--width", "1024", "--height", "512",
+                   "--supersample", "2", "--seed", "11")
         cls.images = os.path.join(cls.scene, "images")
         cls.database = os.path.join(cls.shared, "database.db")
         run_colmap("feature_extractor", "--database_path", cls.database,
@@ -64,11 +60,7 @@ class MapperBAOptionsTest(TempDirTestCase):
         os.makedirs(output)
         run_colmap("bundle_adjuster", "--input_path", model, "--output_path",
                    output, "--BundleAdjustment.sphere_residual", residual)
-        text = output + "_txt"
-        os.makedirs(text)
-        run_colmap("model_converter", "--input_path", output, "--output_path",
-                   text, "--output_type", "TXT")
-        _, images, _ = read_text_model(text)
+        _, images, _ = read_text_model(model_to_text(output, output + "_txt"))
         return {fields[9]: [float(v) for v in fields[1:8]]
                 for fields, _ in images.values()}
 
@@ -132,6 +124,4 @@ class MapperBAOptionsTest(TempDirTestCase):
 
 
 if __name__ == "__main__":
-    if not os.path.exists(RENDER):
-        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
-    unittest.main()
+    main_with_render()

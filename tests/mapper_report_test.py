@@ -4,13 +4,11 @@ no verified pair, no pose), a split into several models is pointed out, and a
 run that makes no model exits non-zero with the same report."""
 import os
 import re
-import subprocess
-import unittest
 
-from cli_util import (CPU_EXTRACTION, CPU_MATCHING, Database, TempDirTestCase,
-                      run_colmap, write_noise_image)
+from cli_util import (Database, TempDirTestCase, main_with_render,
+                      write_noise_image)
+from sphera_common import CPU_EXTRACTION, CPU_MATCHING, run_colmap, run_render
 
-RENDER = os.environ.get("SPHERA_RENDER", "")
 WIDTH, HEIGHT = 640, 480
 
 
@@ -53,9 +51,8 @@ class MapperReportTest(TempDirTestCase):
         # Two arcs of the outward-looking ring (8 and 4 views) that see
         # opposite walls and share no view: two models.
         scene = self.path("scene")
-        subprocess.run([RENDER, "--output", scene, "--layout", "ring",
-                        "--supersample", "2", "--seed", "3"],
-                       check=True, stdout=subprocess.DEVNULL)
+        run_render(scene, "--layout", "ring", "--supersample", "2", "--seed",
+                   "3")
         names = sorted(os.listdir(os.path.join(scene, "images")))
         self.assertEqual(len(names), 16)
         os.makedirs(images)
@@ -122,6 +119,4 @@ class MapperReportTest(TempDirTestCase):
 
 
 if __name__ == "__main__":
-    if not os.path.exists(RENDER):
-        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
-    unittest.main()
+    main_with_render()
