@@ -297,6 +297,29 @@ def run_colmap(*args, check=True, timeout=1800):
                        name="colmap")
 
 
+def extract_features(database, image_path, camera_model, *options,
+                     params=None, single_camera=True, program=None):
+    """Runs feature_extractor on the CPU, with PROGRAM (default run_colmap):
+    the images of IMAGE_PATH into DATABASE, as cameras of CAMERA_MODEL
+    (PARAMS when given; one camera for all of them unless not
+    SINGLE_CAMERA), with further OPTIONS. Returns PROGRAM's result."""
+    command = ["feature_extractor", "--database_path", database,
+               "--image_path", image_path,
+               "--ImageReader.camera_model", camera_model]
+    if params is not None:
+        command += ["--ImageReader.camera_params", params_text(params)]
+    if single_camera:
+        command += ["--ImageReader.single_camera", "1"]
+    return (program or run_colmap)(*command, *options, *CPU_EXTRACTION)
+
+
+def match_exhaustive(database, program=None):
+    """Runs exhaustive_matcher on the CPU on DATABASE with PROGRAM (default
+    run_colmap); returns PROGRAM's result."""
+    return (program or run_colmap)("exhaustive_matcher", "--database_path",
+                                   database, *CPU_MATCHING)
+
+
 def model_to_text(model_path, text_path):
     """TEXT_PATH, made to hold the model at MODEL_PATH as a text model."""
     os.makedirs(text_path)

@@ -14,9 +14,9 @@ import sys
 import unittest
 
 from cli_util import SKIP_EXIT_CODE, Database, TempDirTestCase, require_render
-from sphera_common import (CPU_EXTRACTION, CPU_MATCHING, UPSTREAM_COLMAP,
-                           read_text_model, run_colmap, run_program,
-                           run_render)
+from sphera_common import (UPSTREAM_COLMAP, extract_features,
+                           match_exhaustive, read_text_model, run_colmap,
+                           run_program, run_render)
 
 UPSTREAM = os.environ.get("SPHERA_UPSTREAM_COLMAP", UPSTREAM_COLMAP)
 HAVE_UPSTREAM = os.path.exists(UPSTREAM)
@@ -180,12 +180,9 @@ class InterchangeTest(TempDirTestCase):
         return os.path.join(scene, "images")
 
     def features_and_matches(self, program, images, database):
-        program("feature_extractor", "--database_path", database,
-                "--image_path", images, "--ImageReader.camera_model",
-                "EQUIRECTANGULAR", "--ImageReader.single_camera", "1",
-                *CPU_EXTRACTION)
-        program("exhaustive_matcher", "--database_path", database,
-                *CPU_MATCHING)
+        extract_features(database, images, "EQUIRECTANGULAR",
+                         program=program)
+        match_exhaustive(database, program=program)
 
     def mapped_images(self, program, images, database, name):
         output = self.path(name)

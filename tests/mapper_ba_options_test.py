@@ -12,8 +12,9 @@ import shutil
 import tempfile
 
 from cli_util import TempDirTestCase, main_with_render
-from sphera_common import (CPU_EXTRACTION, CPU_MATCHING, model_to_text,
-                           read_text_model, run_colmap, run_render)
+from sphera_common import (extract_features, match_exhaustive,
+                           model_to_text, read_text_model, run_colmap,
+                           run_render)
 
 
 class MapperBAOptionsTest(TempDirTestCase):
@@ -26,13 +27,8 @@ class MapperBAOptionsTest(TempDirTestCase):
                    "--supersample", "2", "--seed", "11")
         cls.images = os.path.join(cls.scene, "images")
         cls.database = os.path.join(cls.shared, "database.db")
-        run_colmap("feature_extractor", "--database_path", cls.database,
-                   "--image_path", cls.images,
-                   "--ImageReader.camera_model", "EQUIRECTANGULAR",
-                   "--ImageReader.single_camera", "1",
-                   *CPU_EXTRACTION)
-        run_colmap("exhaustive_matcher", "--database_path", cls.database,
-                   *CPU_MATCHING)
+        extract_features(cls.database, cls.images, "EQUIRECTANGULAR")
+        match_exhaustive(cls.database)
 
     @classmethod
     def tearDownClass(cls):

@@ -7,7 +7,8 @@ import re
 
 from cli_util import (Database, TempDirTestCase, main_with_render,
                       write_noise_image)
-from sphera_common import CPU_EXTRACTION, CPU_MATCHING, run_colmap, run_render
+from sphera_common import (extract_features, match_exhaustive, run_colmap,
+                           run_render)
 
 WIDTH, HEIGHT = 640, 480
 
@@ -21,14 +22,9 @@ def write_blank_image(path):
 class MapperReportTest(TempDirTestCase):
     def extract_and_match(self, image_path):
         database = self.path("database.db")
-        run_colmap("feature_extractor", "--database_path", database,
-                   "--image_path", image_path,
-                   "--ImageReader.camera_model", "PINHOLE",
-                   "--ImageReader.camera_params", "320,320,320,240",
-                   "--ImageReader.single_camera", "1",
-                   *CPU_EXTRACTION)
-        run_colmap("exhaustive_matcher", "--database_path", database,
-                   *CPU_MATCHING)
+        extract_features(database, image_path, "PINHOLE",
+                         params=[320, 320, 320, 240])
+        match_exhaustive(database)
         return database
 
     def run_mapper(self, database, image_path, output="sparse",

@@ -6,8 +6,8 @@ import json
 import os
 
 from cli_util import TempDirTestCase, main_with_render
-from sphera_common import (CPU_EXTRACTION, CPU_MATCHING, hybrid_rig,
-                           model_to_text, params_text, read_text_cameras,
+from sphera_common import (extract_features, hybrid_rig, match_exhaustive,
+                           model_to_text, read_text_cameras,
                            read_text_images, run_colmap, run_render,
                            write_rig)
 
@@ -24,15 +24,9 @@ class RenderedSfMTest(TempDirTestCase):
             list_path = self.path(f"list{index}.txt")
             with open(list_path, "w") as f:
                 f.write("\n".join(names) + "\n")
-            run_colmap("feature_extractor", "--database_path", database,
-                       "--image_path", os.path.join(scene, "images"),
-                       "--image_list_path", list_path,
-                       "--ImageReader.camera_model", model,
-                       "--ImageReader.camera_params", params_text(params),
-                       "--ImageReader.single_camera", "1",
-                       *CPU_EXTRACTION)
-        run_colmap("exhaustive_matcher", "--database_path", database,
-                   *CPU_MATCHING)
+            extract_features(database, os.path.join(scene, "images"), model,
+                             "--image_list_path", list_path, params=params)
+        match_exhaustive(database)
         os.makedirs(self.path("sparse"))
         run_colmap("mapper", "--database_path", database, "--image_path",
                    os.path.join(scene, "images"), "--output_path",

@@ -10,10 +10,10 @@ import os
 import numpy as np
 
 from cli_util import TempDirTestCase, main_with_render
-from sphera_common import (CPU_EXTRACTION, CPU_MATCHING, cam_from_world,
-                           fisheye190_rig, model_to_text, params_text,
-                           pose_errors, read_text_model, rig_line, run_colmap,
-                           run_render, write_rig)
+from sphera_common import (cam_from_world, extract_features, fisheye190_rig,
+                           match_exhaustive, model_to_text, pose_errors,
+                           read_text_model, rig_line, run_colmap, run_render,
+                           write_rig)
 
 
 def render(output, rig_lines, supersample=2):
@@ -36,14 +36,9 @@ def ring_of_200_degree_lenses(model, params):
 class SphereModelsOnColmap4Test(TempDirTestCase):
     def reconstruct(self, scene, model, params, mapper="mapper"):
         database = self.path("database.db")
-        run_colmap("feature_extractor", "--database_path", database,
-                   "--image_path", os.path.join(scene, "images"),
-                   "--ImageReader.camera_model", model,
-                   "--ImageReader.camera_params", params_text(params),
-                   "--ImageReader.single_camera", "1",
-                   *CPU_EXTRACTION)
-        run_colmap("exhaustive_matcher", "--database_path", database,
-                   *CPU_MATCHING)
+        extract_features(database, os.path.join(scene, "images"), model,
+                         params=params)
+        match_exhaustive(database)
         os.makedirs(self.path("sparse"))
         run_colmap(mapper, "--database_path", database, "--image_path",
                    os.path.join(scene, "images"), "--output_path",
