@@ -97,11 +97,10 @@ import subprocess
 import sys
 import time
 
-from sphera_common import (CPU_EXTRACTION, CPU_MATCHING, REPO_ROOT,
-                           SHARED_DATA_DIR, UPSTREAM_COLMAP, fisheye190_rig,
-                           hybrid_rig, median, model_counts, params_text,
-                           poles_rig, read_text_cameras, read_text_images,
-                           run_logged)
+from sphera_common import (REPO_ROOT, SHARED_DATA_DIR, UPSTREAM_COLMAP,
+                           extract_features, fisheye190_rig, hybrid_rig,
+                           match_exhaustive, median, model_counts, poles_rig,
+                           read_text_cameras, read_text_images, run_logged)
 
 # Data sets and the camera models their images use.
 DATASET_MODELS = {
@@ -130,8 +129,8 @@ REFERENCE_BUILDER = os.path.normpath(os.path.join(
     REPO_ROOT, "..", "shared", "peers", "build_colmap4.sh"))
 REFERENCE_BUILD_MINUTES = 40
 REFERENCE_SYSTEMS = {REFERENCE}
-# Command-line names of COLMAP 4.x, the same for both systems (and
-# CPU_EXTRACTION, CPU_MATCHING).
+# Command-line names of COLMAP 4.x, the same for both systems (and those
+# of sphera_common's extract_features, match_exhaustive).
 SEED_OPTION = "--default_random_seed"
 DEFAULT_LABEL = "sphera"
 
@@ -470,15 +469,18 @@ class Benchmark:
         database = os.path.join(run_dir, "database.db")
         timeout = self.args.step_timeout
         seeded = [] if seed is None else [SEED_OPTION, str(seed)]
+
+        def step(name):
+            """A `program` for extract_features and match_exhaustive: runs
+            `colmap ARGS` as the step NAME, returns (seconds, output)."""
+            def run(*args):
+                return run_step(name, [colmap, *map(str, args)], logs,
+                                timeout)
+            return run
+
         t_extract = 0.0
         for index, (model, params, image_list) in enumerate(groups):
-            command = [colmap, "feature_extractor", "--database_path", database,
-                       "--image_path", image_path,
-                       "--ImageReader.camera_model", model,
-                       "--ImageReader.single_camera_per_folder", "1"]
-            command += CPU_EXTRACTION + seeded
-            if params:
-                command += ["--ImageReader.camera_params", params_text(params)]
+            options = ["--ImageReader.single_camera_per_folder", "1"] + seeded
             if image_list is None:
                 # An explicit list: SPHERA's feature_extractor fails on
                 # non-image files (a README.md) in the folder.
@@ -487,15 +489,15 @@ class Benchmark:
                 list_path = os.path.join(run_dir, "image_list_%d.txt" % index)
                 with open(list_path, "w") as f:
                     f.write("\n".join(image_list) + "\n")
-                command += ["--image_list_path", list_path]
-            step = "feature_extractor" + ("_%d" % index if len(groups) > 1 else "")
-            seconds, _ = run_step(step, command, logs, timeout)
+                options += ["--image_list_path", list_path]
+            name = "feature_extractor" + ("_%d" % index if len(groups) > 1 else "")
+            seconds, _ = extract_features(
+                database, image_path, model, *options, params=params or None,
+                single_camera=False, program=step(name))
             t_extract += seconds
         row["t_extract_s"] = round(t_extract, 3)
-        seconds, _ = run_step("exhaustive_matcher",
-                              [colmap, "exhaustive_matcher", "--database_path",
-                               database] + CPU_MATCHING + seeded,
-                              logs, timeout)
+        seconds, _ = match_exhaustive(database, *seeded,
+                                      program=step("exhaustive_matcher"))
         row["t_match_s"] = round(seconds, 3)
         sparse = os.path.join(run_dir, "sparse")
         os.makedirs(sparse, exist_ok=True)

@@ -313,11 +313,11 @@ def extract_features(database, image_path, camera_model, *options,
     return (program or run_colmap)(*command, *options, *CPU_EXTRACTION)
 
 
-def match_exhaustive(database, program=None):
-    """Runs exhaustive_matcher on the CPU on DATABASE with PROGRAM (default
-    run_colmap); returns PROGRAM's result."""
+def match_exhaustive(database, *options, program=None):
+    """Runs exhaustive_matcher on the CPU on DATABASE, with further OPTIONS,
+    with PROGRAM (default run_colmap); returns PROGRAM's result."""
     return (program or run_colmap)("exhaustive_matcher", "--database_path",
-                                   database, *CPU_MATCHING)
+                                   database, *options, *CPU_MATCHING)
 
 
 def model_to_text(model_path, text_path):
