@@ -54,44 +54,36 @@ import subprocess
 import sys
 import time
 
-REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import benchmark_sfm  # noqa: E402  (rendered rigs, the SfM pipeline)
+import benchmark_sfm  # noqa: E402  (the SfM pipeline)
+from sphera_common import (REPO_ROOT, poles_rig, quat_mul,  # noqa: E402
+                           quat_rotate, read_text_cameras, read_text_images,
+                           read_text_rows, run_logged, run_render, write_rig)
+
+# Seconds allowed per command.
+STEP_TIMEOUT = 3600
 
 
 # ---------------------------------------------------------------------------
 # COLMAP text model I/O
 # ---------------------------------------------------------------------------
 def read_model(path):
-    cameras, images, points = {}, {}, {}
-    with open(os.path.join(path, "cameras.txt")) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            e = line.split()
-            cameras[int(e[0])] = (e[1], int(e[2]), int(e[3]),
-                                  [float(x) for x in e[4:]])
-    with open(os.path.join(path, "images.txt")) as f:
-        lines = [l for l in f if not l.startswith("#")]
-    for i in range(0, len(lines) - 1, 2):
-        e = lines[i].split()
-        if not e:
-            continue
-        obs = lines[i + 1].split()
-        pts = [[float(obs[k]), float(obs[k + 1]), int(obs[k + 2])]
-               for k in range(0, len(obs), 3)]
-        images[int(e[0])] = {
+    """(cameras {id: (model, width, height, params)}, images {id: {"q", "t",
+    "camera_id", "name", "points2D": [[x, y, point3D_id]]}}, points {id:
+    {"xyz", "rgb" (text), "track"}}) of a text model, in the form that
+    perturb() changes and write_model() writes."""
+    images = {}
+    for image_id, (e, obs) in read_text_images(path).items():
+        images[image_id] = {
             "q": [float(x) for x in e[1:5]], "t": [float(x) for x in e[5:8]],
-            "camera_id": int(e[8]), "name": e[9], "points2D": pts}
-    with open(os.path.join(path, "points3D.txt")) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            e = line.split()
-            track = [(int(e[k]), int(e[k + 1])) for k in range(8, len(e), 2)]
-            points[int(e[0])] = {"xyz": [float(x) for x in e[1:4]],
-                                 "rgb": e[4:7], "track": track}
-    return cameras, images, points
+            "camera_id": int(e[8]), "name": e[9],
+            "points2D": [list(o) for o in obs]}
+    points = {}
+    for e in read_text_rows(os.path.join(path, "points3D.txt")):
+        track = [(int(e[k]), int(e[k + 1])) for k in range(8, len(e), 2)]
+        points[int(e[0])] = {"xyz": [float(x) for x in e[1:4]],
+                             "rgb": e[4:7], "track": track}
+    return read_text_cameras(path), images, points
 
 
 def write_model(path, cameras, images, points):
@@ -116,22 +108,6 @@ def write_model(path, cameras, images, points):
 
 
 # ---------------------------------------------------------------------------
-# Small quaternion helpers (w, x, y, z), no numpy needed here.
-# ---------------------------------------------------------------------------
-def qmul(a, b):
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return [w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2]
-
-
-def qrot(q, v):
-    p = qmul(qmul(q, [0.0] + list(v)), [q[0], -q[1], -q[2], -q[3]])
-    return p[1:]
-
-
 def random_unit(rng):
     while True:
         v = [rng.gauss(0, 1) for _ in range(3)]
@@ -168,14 +144,14 @@ def perturb(gt, rng, sigma_px, outlier_rate, rot_deg, pos_m, point_m,
         # Centre C = -R^T t; perturb rotation and centre.
         q = im["q"]
         qi = [q[0], -q[1], -q[2], -q[3]]
-        c = [-x for x in qrot(qi, im["t"])]
+        c = [-x for x in quat_rotate(qi, im["t"])]
         axis = random_unit(rng)
         ang = math.radians(rot_deg)
         dq = [math.cos(ang / 2)] + [math.sin(ang / 2) * a for a in axis]
-        q2 = qmul(dq, q)
+        q2 = quat_mul(dq, q)
         c2 = [c[k] + pos_m * d for k, d in enumerate(random_unit(rng))]
         im["q"] = q2
-        im["t"] = [-x for x in qrot(q2, c2)]
+        im["t"] = [-x for x in quat_rotate(q2, c2)]
     for pid, p in points.items():
         d = random_unit(rng)
         p["xyz"] = [p["xyz"][k] + point_m * d[k] for k in range(3)]
@@ -183,16 +159,6 @@ def perturb(gt, rng, sigma_px, outlier_rate, rot_deg, pos_m, point_m,
 
 
 # ---------------------------------------------------------------------------
-def run(cmd, log, timeout=3600):
-    t0 = time.time()
-    with open(log, "w") as f:
-        f.write("$ " + " ".join(cmd) + "\n")
-        f.flush()
-        rc = subprocess.call(cmd, stdout=f, stderr=subprocess.STDOUT,
-                             timeout=timeout)
-    return rc, time.time() - t0
-
-
 def wait_for_command(colmap, wait_s):
     t0 = time.time()
     while True:
@@ -213,10 +179,9 @@ def render(args, out_dir, extra):
         return
     if os.path.exists(out_dir):
         shutil.rmtree(out_dir)
-    cmd = [args.render, "--output", out_dir, "--supersample", "1",
-           "--seed", str(args.seed)] + extra
     print("rendering", out_dir, flush=True)
-    subprocess.check_call(cmd, stdout=subprocess.DEVNULL)
+    run_render(out_dir, "--supersample", "1", "--seed", args.seed, *extra,
+               program=args.render)
 
 
 class Bench:
@@ -242,23 +207,27 @@ class Bench:
         total = 0.0
         base = [a.colmap, "sphere_bundle_adjuster", "--output_path", out]
         if mode == "full":
-            rc, dt = run(base + ["--input_path", input_model, "--mode", "full",
-                                 "--residual", residual, "--loss", "cauchy",
-                                 "--loss_scale_px", "1"] + list(extra),
-                         os.path.join(work, "ba.log"))
+            rc, dt = run_logged(
+                base + ["--input_path", input_model, "--mode", "full",
+                        "--residual", residual, "--loss", "cauchy",
+                        "--loss_scale_px", "1"] + list(extra),
+                os.path.join(work, "ba.log"), STEP_TIMEOUT)
             total += dt
         else:
             stage1 = os.path.join(work, "stage1")
-            rc, dt = run([a.colmap, "sphere_bundle_adjuster", "--input_path",
-                          input_model, "--output_path", stage1, "--mode",
-                          "camera_only", "--tau_px", "8", "--max_iterations",
-                          "5"] + list(extra), os.path.join(work, "stage1.log"))
+            rc, dt = run_logged(
+                [a.colmap, "sphere_bundle_adjuster", "--input_path",
+                 input_model, "--output_path", stage1, "--mode",
+                 "camera_only", "--tau_px", "8", "--max_iterations",
+                 "5"] + list(extra), os.path.join(work, "stage1.log"),
+                STEP_TIMEOUT)
             total += dt
             if rc == 0:
-                rc, dt = run(base + ["--input_path", stage1, "--mode",
-                                     "camera_only", "--tau_px", str(tau),
-                                     "--max_iterations", "20"] + list(extra),
-                             os.path.join(work, "ba.log"))
+                rc, dt = run_logged(
+                    base + ["--input_path", stage1, "--mode", "camera_only",
+                            "--tau_px", str(tau), "--max_iterations",
+                            "20"] + list(extra),
+                    os.path.join(work, "ba.log"), STEP_TIMEOUT)
                 total += dt
         row = {"run": tag, "mode": mode, "residual": residual,
                "tau_px": "" if tau is None else tau, "status": "ok",
@@ -268,10 +237,11 @@ class Bench:
             return row
         ev = os.path.join(work, "eval")
         os.makedirs(ev)
-        rc, _ = run([a.colmap, "model_evaluator", "--gt_path",
-                     gt_path, "--input_path", out, "--depth_path",
-                     depth_path or os.path.join(scene, "depth"),
-                     "--output_path", ev], os.path.join(work, "eval.log"))
+        rc, _ = run_logged([a.colmap, "model_evaluator", "--gt_path",
+                            gt_path, "--input_path", out, "--depth_path",
+                            depth_path or os.path.join(scene, "depth"),
+                            "--output_path", ev],
+                           os.path.join(work, "eval.log"), STEP_TIMEOUT)
         if rc != 0:
             row["status"] = "eval_failed"
             return row
@@ -335,13 +305,6 @@ def print_table(title, rows, keys):
         print("  ".join(fmt(r.get(k, "")).ljust(w) for k, w in zip(keys, widths)))
 
 
-def pole_rig(path):
-    """The pole-heavy rig of benchmark_sfm.py (room_poles): 9 upright
-    panoramas alternately near the ceiling and near the floor."""
-    with open(path, "w") as f:
-        f.write("\n".join(benchmark_sfm.poles_rig()) + "\n")
-
-
 def ratio_row(angular, pixel, base):
     """`base` plus pixel/angular ratios of the error columns of two rows."""
     row = dict(base, residual="pixel/angular", status="")
@@ -366,10 +329,10 @@ def yaw_pitch_pose(yaw_deg, pitch_deg, centre):
     turned by yaw about +Y (0 deg: looking along +Z, 90 deg: along +X), then
     pitched about its x axis."""
     a, b = math.radians(yaw_deg), math.radians(pitch_deg)
-    q_wc = qmul([math.cos(a / 2), 0.0, math.sin(a / 2), 0.0],
+    q_wc = quat_mul([math.cos(a / 2), 0.0, math.sin(a / 2), 0.0],
                 [math.cos(b / 2), math.sin(b / 2), 0.0, 0.0])
     q_cw = [q_wc[0], -q_wc[1], -q_wc[2], -q_wc[3]]
-    t = [-x for x in qrot(q_cw, centre)]
+    t = [-x for x in quat_rotate(q_cw, centre)]
     return q_cw, t
 
 
@@ -498,11 +461,13 @@ def run_fig9(args, bench, root, protocol, quick):
                 # The adjuster writes binary: convert to text, read cameras.txt.
                 txt = r["_model"] + "_txt"
                 os.makedirs(txt, exist_ok=True)
-                rc, _ = run([args.colmap, "model_converter", "--input_path",
-                             r["_model"], "--output_path", txt,
-                             "--output_type", "TXT"],
-                            os.path.join(os.path.dirname(txt), "convert.log"))
-                out_cams = read_model(txt)[0] if rc == 0 else {}
+                rc, _ = run_logged(
+                    [args.colmap, "model_converter", "--input_path",
+                     r["_model"], "--output_path", txt, "--output_type",
+                     "TXT"],
+                    os.path.join(os.path.dirname(txt), "convert.log"),
+                    STEP_TIMEOUT)
+                out_cams = read_text_cameras(txt) if rc == 0 else {}
                 if rc != 0:
                     row["status"] = "convert_failed"
                 pin = [p for m, w, h, p in out_cams.values() if m == "PINHOLE"]
@@ -828,8 +793,10 @@ def main():
 
     if "poles" in only:
         # Pole-heavy scene: angular vs pixel residual.
+        # The pole-heavy rig of benchmark_sfm.py (room_poles): 9 upright
+        # panoramas alternately near the ceiling and near the floor.
         rig = os.path.join(root, "pole_rig.txt")
-        pole_rig(rig)
+        write_rig(rig, poles_rig())
         pole_scene = os.path.join(root, "scenes", "poles_%d" % counts[-1])
         render(args, pole_scene, ["--rig", rig, "--points", str(counts[-1])])
         pgt = read_model(os.path.join(pole_scene, "sparse_gt"))

@@ -97,7 +97,10 @@ import subprocess
 import sys
 import time
 
-REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from sphera_common import (REPO_ROOT, SHARED_DATA_DIR, UPSTREAM_COLMAP,
+                           extract_features, fisheye190_rig, hybrid_rig,
+                           match_exhaustive, median, model_counts, poles_rig,
+                           read_text_cameras, read_text_images, run_logged)
 
 # Data sets and the camera models their images use.
 DATASET_MODELS = {
@@ -126,12 +129,8 @@ REFERENCE_BUILDER = os.path.normpath(os.path.join(
     REPO_ROOT, "..", "shared", "peers", "build_colmap4.sh"))
 REFERENCE_BUILD_MINUTES = 40
 REFERENCE_SYSTEMS = {REFERENCE}
-UPSTREAM_COLMAP = os.path.join(os.path.expanduser("~"), ".cache", "sphera-peers",
-                               "colmap4", "build", "src", "colmap", "exe",
-                               "colmap")
-# Command-line names of COLMAP 4.x, the same for both systems.
-EXTRACTION_GPU = "--FeatureExtraction.use_gpu"
-MATCHING_GPU = "--FeatureMatching.use_gpu"
+# Command-line names of COLMAP 4.x, the same for both systems (and those
+# of sphera_common's extract_features, match_exhaustive).
 SEED_OPTION = "--default_random_seed"
 DEFAULT_LABEL = "sphera"
 
@@ -242,53 +241,20 @@ def run_step(name, command, log_dir, timeout):
     log_path = os.path.join(log_dir, name + ".log")
     env = dict(os.environ)
     env.setdefault("QT_QPA_PLATFORM", "offscreen")
-    start = time.monotonic()
-    with open(log_path, "w") as log_file:
-        log_file.write("$ " + " ".join(command) + "\n")
-        log_file.flush()
-        try:
-            process = subprocess.run(command, stdout=log_file,
-                                     stderr=subprocess.STDOUT, env=env,
-                                     timeout=timeout, cwd=REPO_ROOT)
-        except subprocess.TimeoutExpired:
-            raise StepError("%s timed out after %d s (log %s)" %
-                            (name, timeout, log_path))
-        except OSError as error:
-            raise StepError("%s: cannot run %s: %s" % (name, command[0], error))
-    seconds = time.monotonic() - start
+    try:
+        returncode, seconds = run_logged(command, log_path, timeout, env=env,
+                                         cwd=REPO_ROOT)
+    except subprocess.TimeoutExpired:
+        raise StepError("%s timed out after %d s (log %s)" %
+                        (name, timeout, log_path))
+    except OSError as error:
+        raise StepError("%s: cannot run %s: %s" % (name, command[0], error))
     with open(log_path, errors="replace") as log_file:
         output = log_file.read()
-    if process.returncode != 0:
+    if returncode != 0:
         raise StepError("%s failed (exit %d): %s" %
-                        (name, process.returncode, error_summary(output)))
+                        (name, returncode, error_summary(output)))
     return seconds, output
-
-
-def count_binary_model(model_dir):
-    """(registered images, points) of a COLMAP binary (or text) model."""
-    def binary_count(path):
-        with open(path, "rb") as f:
-            return struct.unpack("<Q", f.read(8))[0]
-
-    def text_count(path, lines_per_item):
-        count = 0
-        with open(path) as f:
-            for line in f:
-                if line.strip() and not line.startswith("#"):
-                    count += 1
-        return count // lines_per_item
-
-    images_bin = os.path.join(model_dir, "images.bin")
-    if os.path.exists(images_bin):
-        return (binary_count(images_bin),
-                binary_count(os.path.join(model_dir, "points3D.bin")))
-    images_txt = os.path.join(model_dir, "images.txt")
-    if os.path.exists(images_txt):
-        # Text images.txt: an empty POINTS2D line may be dropped by the
-        # count; count header lines only.
-        return (len(read_text_images(images_txt)),
-                text_count(os.path.join(model_dir, "points3D.txt"), 1))
-    return None
 
 
 def sparse_models(sparse_dir):
@@ -297,7 +263,7 @@ def sparse_models(sparse_dir):
     for path in sorted(glob.glob(os.path.join(sparse_dir, "*"))):
         if not os.path.isdir(path):
             continue
-        counts = count_binary_model(path)
+        counts = model_counts(path)
         if counts is not None:
             models.append((counts[0], counts[1], path))
     models.sort(key=lambda m: (-m[0], -m[1]))
@@ -343,154 +309,6 @@ def is_number(text):
         return True
     except ValueError:
         return False
-
-
-def read_text_cameras(path):
-    """{camera_id: (model, width, height, [params])} of a cameras.txt."""
-    cameras = {}
-    with open(path) as f:
-        for line in f:
-            tokens = line.split()
-            if not tokens or tokens[0].startswith("#"):
-                continue
-            cameras[int(tokens[0])] = (tokens[1], int(tokens[2]),
-                                       int(tokens[3]), tokens[4:])
-    return cameras
-
-
-def read_text_images(path):
-    """[(image_id, camera_id, name)] of an images.txt (header lines are the
-    ones with 10 tokens ending in a non-numeric name)."""
-    images = []
-    with open(path) as f:
-        for line in f:
-            tokens = line.split()
-            if (len(tokens) == 10 and not tokens[0].startswith("#")
-                    and not is_number(tokens[9])):
-                images.append((int(tokens[0]), int(tokens[8]), tokens[9]))
-    return images
-
-
-# ---------------------------------------------------------------------------
-# Rigs of the rendered sets (cam_from_world poses for sphera_render)
-
-
-def axis_rotation(axis, angle):
-    c, s = math.cos(angle), math.sin(angle)
-    if axis == 0:
-        return [[1, 0, 0], [0, c, -s], [0, s, c]]
-    if axis == 1:
-        return [[c, 0, s], [0, 1, 0], [-s, 0, c]]
-    return [[c, -s, 0], [s, c, 0], [0, 0, 1]]
-
-
-def matmul(a, b):
-    return [[sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)]
-            for i in range(3)]
-
-
-def quaternion_from_matrix(r):
-    """(w, x, y, z) of a rotation matrix."""
-    trace = r[0][0] + r[1][1] + r[2][2]
-    if trace > 0:
-        s = 2 * math.sqrt(trace + 1)
-        w, x = 0.25 * s, (r[2][1] - r[1][2]) / s
-        y, z = (r[0][2] - r[2][0]) / s, (r[1][0] - r[0][1]) / s
-    elif r[0][0] > r[1][1] and r[0][0] > r[2][2]:
-        s = 2 * math.sqrt(1 + r[0][0] - r[1][1] - r[2][2])
-        w, x = (r[2][1] - r[1][2]) / s, 0.25 * s
-        y, z = (r[0][1] + r[1][0]) / s, (r[0][2] + r[2][0]) / s
-    elif r[1][1] > r[2][2]:
-        s = 2 * math.sqrt(1 + r[1][1] - r[0][0] - r[2][2])
-        w, x = (r[0][2] - r[2][0]) / s, (r[0][1] + r[1][0]) / s
-        y, z = 0.25 * s, (r[1][2] + r[2][1]) / s
-    else:
-        s = 2 * math.sqrt(1 + r[2][2] - r[0][0] - r[1][1])
-        w, x = (r[1][0] - r[0][1]) / s, (r[0][2] + r[2][0]) / s
-        y, z = (r[1][2] + r[2][1]) / s, 0.25 * s
-    return (w, x, y, z) if w >= 0 else (-w, -x, -y, -z)
-
-
-def rig_line(name, model, width, height, params, centre, yaw_deg,
-             pitch_deg=0.0, roll_deg=0.0):
-    """A sphera_render rig line. The camera heads `yaw` about the vertical
-    (0 = +Z, 90 = +X), then pitches (positive = up, the world's -Y) and
-    rolls; centre is in world coordinates (+Y down, floor at y = 1.5)."""
-    d = math.pi / 180
-    world_from_cam = matmul(matmul(axis_rotation(1, yaw_deg * d),
-                                   axis_rotation(0, pitch_deg * d)),
-                            axis_rotation(2, roll_deg * d))
-    cam_from_world = [[world_from_cam[j][i] for j in range(3)]
-                      for i in range(3)]
-    t = [-sum(cam_from_world[i][k] * centre[k] for k in range(3))
-         for i in range(3)]
-    q = quaternion_from_matrix(cam_from_world)
-    numbers = " ".join("%.12g" % v for v in list(q) + t)
-    return "%s %s %d %d %s | %s" % (name, model, width, height,
-                                   " ".join("%.12g" % p for p in params),
-                                   numbers)
-
-
-FISHEYE_PARAMS = [450.56, 450.56, 512, 512, 1.0, 0, 0, 0, 0]  # 190 deg
-EQUIRECT_PARAMS = [2048, 1024]
-PINHOLE_800_PARAMS = [400, 400, 400, 300]  # 90 deg horizontal
-
-
-def fisheye190_rig():
-    """12 fisheye cameras: the room9 grid plus 3 off-grid, looking in varied
-    directions (horizontal, tilted, straight up and down)."""
-    poses = [  # centre, yaw, pitch, roll
-        ((-1, 0, -1), 45, 0, 0),
-        ((0, 0, -1), 0, 60, 0),
-        ((1, 0, -1), -45, 0, 10),
-        ((-1, 0, 0), 90, -45, 0),
-        ((0, 0, 0), 0, 90, 0),
-        ((1, 0, 0), -90, -45, 0),
-        ((-1, 0, 1), 135, 20, 0),
-        ((0, 0, 1), 180, -90, 0),
-        ((1, 0, 1), -135, 20, -10),
-        ((-0.5, -0.3, -0.5), 200, 0, 0),
-        ((0.5, -0.3, 0.5), 20, 0, 0),
-        ((0.5, 0.3, -0.5), -90, 30, 15),
-    ]
-    return [rig_line("fish%02d" % i, "UNIFIED_OMNI", 1024, 1024,
-                     FISHEYE_PARAMS, c, yaw, pitch, roll)
-            for i, (c, yaw, pitch, roll) in enumerate(poses)]
-
-
-def hybrid_rig():
-    """4 equirect at the grid corners, 4 fisheye at the grid edges, 4 pinhole
-    near the centre looking out at the room's corners."""
-    lines = []
-    for i, (c, yaw) in enumerate([((-1, 0, -1), 10), ((1, 0, -1), 100),
-                                  ((-1, 0, 1), 200), ((1, 0, 1), 300)]):
-        lines.append(rig_line("eq%d" % i, "EQUIRECTANGULAR", 2048, 1024,
-                              EQUIRECT_PARAMS, c, yaw, 2 * (i % 2), -2))
-    for i, (c, yaw, pitch) in enumerate([((0, -0.2, -1), 180, 0),
-                                         ((1, 0, 0), 90, 30),
-                                         ((0, 0.2, 1), 0, -30),
-                                         ((-1, 0, 0), -90, 60)]):
-        lines.append(rig_line("fish%d" % i, "UNIFIED_OMNI", 1024, 1024,
-                              FISHEYE_PARAMS, c, yaw, pitch))
-    for i, (c, yaw) in enumerate([((0.3, 0, 0.3), 45), ((-0.3, 0, 0.3), -45),
-                                  ((-0.3, 0, -0.3), -135),
-                                  ((0.3, 0, -0.3), 135)]):
-        lines.append(rig_line("pin%d" % i, "PINHOLE", 800, 600,
-                              PINHOLE_800_PARAMS, c, yaw, 5 * (i % 2 * 2 - 1)))
-    return lines
-
-
-def poles_rig():
-    """9 upright equirectangular cameras on the room9 grid, alternately 0.6 m
-    below the ceiling and 0.6 m above the floor, so that floor and ceiling
-    features are seen close to the poles of the panoramas."""
-    lines = []
-    for k in range(9):
-        centre = ((k % 3 - 1) * 0.8, -0.9 if k % 2 == 0 else 0.9,
-                  (k // 3 - 1) * 0.8)
-        lines.append(rig_line("pole%02d" % k, "EQUIRECTANGULAR", 2048, 1024,
-                              EQUIRECT_PARAMS, centre, 0))
-    return lines
 
 
 # Rendered sets: sphera_render arguments (a rig's lines, or layout options).
@@ -651,16 +469,18 @@ class Benchmark:
         database = os.path.join(run_dir, "database.db")
         timeout = self.args.step_timeout
         seeded = [] if seed is None else [SEED_OPTION, str(seed)]
+
+        def step(name):
+            """A `program` for extract_features and match_exhaustive: runs
+            `colmap ARGS` as the step NAME, returns (seconds, output)."""
+            def run(*args):
+                return run_step(name, [colmap, *map(str, args)], logs,
+                                timeout)
+            return run
+
         t_extract = 0.0
         for index, (model, params, image_list) in enumerate(groups):
-            command = [colmap, "feature_extractor", "--database_path", database,
-                       "--image_path", image_path,
-                       "--ImageReader.camera_model", model,
-                       "--ImageReader.single_camera_per_folder", "1",
-                       EXTRACTION_GPU, "0"] + seeded
-            if params:
-                command += ["--ImageReader.camera_params",
-                            ",".join(str(p) for p in params)]
+            options = ["--ImageReader.single_camera_per_folder", "1"] + seeded
             if image_list is None:
                 # An explicit list: SPHERA's feature_extractor fails on
                 # non-image files (a README.md) in the folder.
@@ -669,15 +489,15 @@ class Benchmark:
                 list_path = os.path.join(run_dir, "image_list_%d.txt" % index)
                 with open(list_path, "w") as f:
                     f.write("\n".join(image_list) + "\n")
-                command += ["--image_list_path", list_path]
-            step = "feature_extractor" + ("_%d" % index if len(groups) > 1 else "")
-            seconds, _ = run_step(step, command, logs, timeout)
+                options += ["--image_list_path", list_path]
+            name = "feature_extractor" + ("_%d" % index if len(groups) > 1 else "")
+            seconds, _ = extract_features(
+                database, image_path, model, *options, params=params or None,
+                single_camera=False, program=step(name))
             t_extract += seconds
         row["t_extract_s"] = round(t_extract, 3)
-        seconds, _ = run_step("exhaustive_matcher",
-                              [colmap, "exhaustive_matcher", "--database_path",
-                               database, MATCHING_GPU, "0"] + seeded,
-                              logs, timeout)
+        seconds, _ = match_exhaustive(database, *seeded,
+                                      program=step("exhaustive_matcher"))
         row["t_match_s"] = round(seconds, 3)
         sparse = os.path.join(run_dir, "sparse")
         os.makedirs(sparse, exist_ok=True)
@@ -748,8 +568,9 @@ class Benchmark:
         rendered set. With several GT cameras (hybrid) every camera's images
         go to their own subfolder (symlinks) and the GT is renamed to match."""
         gt = os.path.join(scene, "sparse_gt")
-        cameras = read_text_cameras(os.path.join(gt, "cameras.txt"))
-        images = read_text_images(os.path.join(gt, "images.txt"))
+        cameras = read_text_cameras(gt)
+        images = [(int(fields[8]), fields[9])
+                  for fields, _ in read_text_images(gt).values()]
         if len(cameras) == 1:
             (model, _, _, params), = cameras.values()
             return (os.path.join(scene, "images"), [(model, params, None)], gt,
@@ -765,7 +586,7 @@ class Benchmark:
         new_gt = os.path.join(gt_root, "sparse")
         depth_root = os.path.join(gt_root, "depth")
         renamed = {}
-        for _, camera_id, name in images:
+        for camera_id, name in images:
             folder = folders[camera_id]
             renamed[name] = folder + "/" + name
             for root, source in ((image_root, os.path.join(scene, "images", name)),
@@ -788,7 +609,7 @@ class Benchmark:
                 dst.write(line)
         groups = []
         for camera_id, (model, _, _, params) in sorted(cameras.items()):
-            names = [renamed[n] for _, c, n in images if c == camera_id]
+            names = [renamed[n] for c, n in images if c == camera_id]
             groups.append((model, params, names))
         return image_root, groups, new_gt, depth_root
 
@@ -855,7 +676,7 @@ class Benchmark:
             else:
                 raise StepError("unknown data set")
             if gt:
-                row["total"] = len(read_text_images(os.path.join(gt, "images.txt")))
+                row["total"] = len(read_text_images(gt))
             log("%s/%s run %d: reconstructing" % (dataset, system, repeat))
             model = self.reconstruct(colmap, run_dir, image_path, groups, row,
                                      mapper_options, seed)
@@ -906,14 +727,6 @@ class Benchmark:
 
 # ---------------------------------------------------------------------------
 # Results
-
-
-def median(values):
-    values = sorted(values)
-    middle = len(values) // 2
-    if len(values) % 2:
-        return values[middle]
-    return (values[middle - 1] + values[middle]) / 2
 
 
 def is_ok(row):
@@ -1243,7 +1056,7 @@ def make_parser():
     parser.add_argument("--upstream_colmap", default=UPSTREAM_COLMAP,
                         help="unpatched upstream COLMAP 4.x, the reference "
                              "(default %(default)s)")
-    parser.add_argument("--data_dir", default=os.path.join(REPO_ROOT, "..", "shared", "data"),
+    parser.add_argument("--data_dir", default=SHARED_DATA_DIR,
                         help="shared real data (strecha/, equirect_flat/)")
     parser.add_argument("--wait_minutes", type=float, default=0,
                         help="wait up to this long for SPHERA's colmap and "

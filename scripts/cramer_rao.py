@@ -64,7 +64,7 @@ Gauge
   null(K) and X S Q = Q.)  Two alignments are implemented:
   centers:   (model_evaluator --alignment centers, its default) the
              least-squares similarity on the camera centres (Umeyama
-             1991, tests/cli_util.py pose_errors).  Linearised it is the
+             1991, sphera_common.pose_errors).  Linearised it is the
              orthogonal projection of the centre errors off the span of
              the centre generators G_C:  K = (G_C^T G_C)^-1 G_C^T E_C, E_C
              picking the centres out of the camera parameters, i.e. the
@@ -110,9 +110,7 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                                "..", "tests"))
-from cli_util import read_text_model, rotation_from_quaternion  # noqa: E402
+from sphera_common import read_text_model, rotation_from_quaternion
 
 FD_STEP = 1e-5  # central-difference step, relative to |y|
 GAUGES = ("centers", "orientations")

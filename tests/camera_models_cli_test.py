@@ -5,8 +5,9 @@ import os
 import struct
 import unittest
 
-from cli_util import (CPU_EXTRACTION, EXTRACTION, Database, TempDirTestCase,
-                      read_text_cameras, run_colmap, write_noise_image)
+from cli_util import Database, TempDirTestCase, write_noise_image
+from sphera_common import (CPU_EXTRACTION, EXTRACTION, read_text_cameras,
+                           run_colmap)
 
 # One camera of every new model, with the ids upstream COLMAP 4.1 and our
 # README use.

@@ -8,8 +8,8 @@ import tempfile
 import unittest
 
 from cli_util import TempDirTestCase
+from sphera_common import REPO_ROOT
 
-REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 COLMAP_SHA256 = \
     "1c6c1a735774d8bc442900d52aac5359dcc9c7ffe53d3daba054fa3095de8dc1"
 

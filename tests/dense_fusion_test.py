@@ -11,32 +11,20 @@ sphere_undistorter_cli_test.py and export_retriangulation_test.py."""
 import math
 import os
 import struct
-import subprocess
-import unittest
 
-from cli_util import TempDirTestCase, read_text_model, run_colmap
-
-RENDER = os.environ.get("SPHERA_RENDER", "")
-
-
-def rotation_matrix(q):
-    w, x, y, z = q
-    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
-
-
-def mat_vec(m, v):
-    return [m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2] for i in range(3)]
+from cli_util import TempDirTestCase, main_with_render
+from sphera_common import (mat_vec, model_to_text, read_text_model,
+                           rotation_matrix, run_colmap, run_render, transpose)
 
 
 def mat_t_vec(m, v):
-    return [m[0][i] * v[0] + m[1][i] * v[1] + m[2][i] * v[2] for i in range(3)]
+    """m transposed times v."""
+    return mat_vec(transpose(m), v)
 
 
 def pose(fields):
     """(cam_from_world rotation matrix, camera centre) of an images.txt line."""
-    rotation = rotation_matrix([float(v) for v in fields[1:5]])
+    rotation = rotation_matrix(*(float(v) for v in fields[1:5]))
     t = [float(v) for v in fields[5:8]]
     return rotation, [-c for c in mat_t_vec(rotation, t)]
 
@@ -106,22 +94,16 @@ class DenseFusionTest(TempDirTestCase):
         scene = self.path("scene")
         # Ground-truth points too: COLMAP's fusion takes each face's
         # neighbours from the sparse points it shares with them.
-        subprocess.run([RENDER, "--output", scene, "--layout", "room9",
-                        "--model", "EQUIRECTANGULAR", "--width", "512",
-                        "--height", "256", "--supersample", "1", "--seed", "5",
-                        "--points", "3000"],
-                       check=True, stdout=subprocess.DEVNULL)
+        run_render(scene, "--layout", "room9", "--model", "EQUIRECTANGULAR",
+                   "--width", "512", "--height", "256", "--supersample", "1",
+                   "--seed", "5", "--points", "3000")
         dense = self.path("dense")
         run_colmap("sphere_undistorter", "--input_path",
                    os.path.join(scene, "sparse_gt"), "--image_path",
                    os.path.join(scene, "images"), "--output_path", dense,
                    "--face_size", 96)
-        text = self.path("faces_txt")
-        os.makedirs(text)
-        run_colmap("model_converter", "--input_path",
-                   os.path.join(dense, "sparse"), "--output_path", text,
-                   "--output_type", "TXT")
-        faces_cameras, faces, _ = read_text_model(text)
+        faces_cameras, faces, _ = read_text_model(model_to_text(
+            os.path.join(dense, "sparse"), self.path("faces_txt")))
         _, panoramas, _ = read_text_model(os.path.join(scene, "sparse_gt"))
         panos = []
         for fields, _ in panoramas.values():
@@ -208,6 +190,4 @@ class DenseFusionTest(TempDirTestCase):
 
 
 if __name__ == "__main__":
-    if not os.path.exists(RENDER):
-        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
-    unittest.main()
+    main_with_render()

@@ -4,9 +4,9 @@ the repository: the test is skipped without it)."""
 import os
 import unittest
 
-from cli_util import (CPU_EXTRACTION, CPU_MATCHING, SHARED_DATA, Database,
-                      TempDirTestCase, analyze_model, main_with_skip,
-                      run_colmap)
+from cli_util import SHARED_DATA, Database, TempDirTestCase, main_with_skip
+from sphera_common import (analyze_model, extract_features,
+                           match_exhaustive, run_colmap)
 
 IMAGES = os.path.join(SHARED_DATA, "equirect_flat", "images")
 
@@ -14,10 +14,8 @@ IMAGES = os.path.join(SHARED_DATA, "equirect_flat", "images")
 class EquirectFlatTest(TempDirTestCase):
     def test_reconstruct_with_equirectangular_model(self):
         database_path = self.path("database.db")
-        run_colmap("feature_extractor", "--database_path", database_path,
-                   "--image_path", IMAGES,
-                   "--ImageReader.camera_model", "EQUIRECTANGULAR",
-                   *CPU_EXTRACTION)
+        extract_features(database_path, IMAGES, "EQUIRECTANGULAR",
+                         single_camera=False)
         database = Database(database_path)
         images = database.images()
         self.assertEqual(len(images), 11)
@@ -31,8 +29,7 @@ class EquirectFlatTest(TempDirTestCase):
             self.assertGreater(count, 2000, name)
         database.close()
 
-        run_colmap("exhaustive_matcher", "--database_path", database_path,
-                   *CPU_MATCHING)
+        match_exhaustive(database_path)
         database = Database(database_path)
         num_pairs = database.scalar("SELECT COUNT(*) FROM matches")
         self.assertEqual(num_pairs, 55)

@@ -5,9 +5,9 @@ on the sphere and reconstructed by the mapper from that pair alone."""
 import os
 import unittest
 
-from cli_util import (CPU_EXTRACTION, CPU_MATCHING, SHARED_DATA, Database,
-                      TempDirTestCase, analyze_model, main_with_skip,
-                      run_colmap)
+from cli_util import SHARED_DATA, Database, TempDirTestCase, main_with_skip
+from sphera_common import (analyze_model, extract_features,
+                           match_exhaustive, run_colmap)
 
 IMAGES = os.path.join(SHARED_DATA, "equirect_pair")
 
@@ -15,13 +15,8 @@ IMAGES = os.path.join(SHARED_DATA, "equirect_pair")
 class EquirectPairTest(TempDirTestCase):
     def test_pair_is_verified_on_the_sphere_and_reconstructed(self):
         database_path = self.path("database.db")
-        run_colmap("feature_extractor", "--database_path", database_path,
-                   "--image_path", IMAGES,
-                   "--ImageReader.camera_model", "EQUIRECTANGULAR",
-                   "--ImageReader.single_camera", "1",
-                   *CPU_EXTRACTION)
-        run_colmap("exhaustive_matcher", "--database_path", database_path,
-                   *CPU_MATCHING)
+        extract_features(database_path, IMAGES, "EQUIRECTANGULAR")
+        match_exhaustive(database_path)
         database = Database(database_path)
         self.assertEqual(len(database.images()), 2)
         (camera,) = database.cameras().values()

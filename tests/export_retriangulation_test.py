@@ -6,12 +6,10 @@ import math
 import os
 import sqlite3
 import struct
-import subprocess
-import unittest
 
-from cli_util import TempDirTestCase, read_text_model, run_colmap
-
-RENDER = os.environ.get("SPHERA_RENDER", "")
+from cli_util import TempDirTestCase, main_with_render
+from sphera_common import (model_to_text, read_text_model, run_colmap,
+                           run_render)
 
 PINHOLE_MODEL_ID = 1
 MAX_IMAGE_ID = 2147483647
@@ -93,19 +91,13 @@ def panorama_of(image_name):
 
 class ExportRetriangulationTest(TempDirTestCase):
     def to_text(self, sparse, name):
-        text = self.path(name)
-        os.makedirs(text)
-        run_colmap("model_converter", "--input_path", sparse, "--output_path",
-                   text, "--output_type", "TXT")
-        return text
+        return model_to_text(sparse, self.path(name))
 
     def test_point_triangulator_reproduces_exported_points(self):
         scene = self.path("scene")
-        subprocess.run([RENDER, "--output", scene, "--layout", "room9",
-                        "--model", "EQUIRECTANGULAR", "--width", "1024",
-                        "--height", "512", "--supersample", "1", "--points",
-                        "400", "--seed", "3"],
-                       check=True, stdout=subprocess.DEVNULL)
+        run_render(scene, "--layout", "room9", "--model", "EQUIRECTANGULAR",
+                   "--width", "1024", "--height", "512", "--supersample", "1",
+                   "--points", "400", "--seed", "3")
         _, _, gt_points = read_text_model(os.path.join(scene, "sparse_gt"))
 
         workspace = self.path("workspace")
@@ -180,6 +172,4 @@ class ExportRetriangulationTest(TempDirTestCase):
 
 
 if __name__ == "__main__":
-    if not os.path.exists(RENDER):
-        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
-    unittest.main()
+    main_with_render()

@@ -9,24 +9,15 @@ PINHOLE projection of its 3D point, and the view's pixel there shows what
 the fisheye image shows at the original observation."""
 import math
 import os
-import subprocess
-import unittest
 
 import numpy as np
 from matplotlib import image as mpimg
 
-from cli_util import (TempDirTestCase, read_text_model,
-                      rotation_from_quaternion, run_colmap)
+from cli_util import TempDirTestCase, main_with_render
+from sphera_common import (cam_from_world, model_to_text, read_text_model,
+                           run_colmap, run_render)
 
-RENDER = os.environ.get("SPHERA_RENDER", "")
 SIZE = 512
-
-
-def to_text(model, text):
-    os.makedirs(text)
-    run_colmap("model_converter", "--input_path", model, "--output_path",
-               text, "--output_type", "TXT")
-    return read_text_model(text)
 
 
 def gray(path):
@@ -40,18 +31,17 @@ def gray(path):
 class ImageUndistorterFisheyeTest(TempDirTestCase):
     def undistort(self, model, *extra):
         scene = self.path("scene_" + model)
-        subprocess.run([RENDER, "--output", scene, "--seed", "11", "--layout",
-                        "room9", "--model", model, "--width", str(SIZE),
-                        "--height", str(SIZE), "--supersample", "2",
-                        "--points", "1500", "--format", "png"],
-                       check=True, stdout=subprocess.DEVNULL)
+        run_render(scene, "--seed", "11", "--layout", "room9", "--model",
+                   model, "--width", SIZE, "--height", SIZE, "--supersample",
+                   "2", "--points", "1500", "--format", "png")
         output = self.path("dense_" + model)
         run_colmap("image_undistorter", "--image_path",
                    os.path.join(scene, "images"), "--input_path",
                    os.path.join(scene, "sparse_gt"), "--output_path", output,
                    *extra)
         source = read_text_model(os.path.join(scene, "sparse_gt"))
-        views = to_text(os.path.join(output, "sparse"), output + "_txt")
+        views = read_text_model(model_to_text(os.path.join(output, "sparse"),
+                                              output + "_txt"))
         return scene, output, source, views
 
     def check_views(self, model, max_half_angle_deg, *extra):
@@ -79,8 +69,7 @@ class ImageUndistorterFisheyeTest(TempDirTestCase):
             self.assertEqual(fields[1:10], src_fields[1:10])  # same pose, name
             self.assertEqual(len(observations), len(src_observations))
             fx, fy, cx, cy = cameras[int(fields[8])][3]
-            rotation = rotation_from_quaternion(*map(float, fields[1:5]))
-            translation = np.array([float(v) for v in fields[5:8]])
+            rotation, translation = cam_from_world(fields)
             view = gray(os.path.join(output, "images", fields[9]))
             fisheye = gray(os.path.join(scene, "images", fields[9]))
             for (x, y, point_id), (sx, sy, _) in zip(observations,
@@ -123,6 +112,4 @@ class ImageUndistorterFisheyeTest(TempDirTestCase):
 
 
 if __name__ == "__main__":
-    if not os.path.exists(RENDER):
-        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
-    unittest.main()
+    main_with_render()

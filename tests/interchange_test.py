@@ -10,18 +10,15 @@ the upstream directions are skipped, saying so, without it."""
 import os
 import sqlite3
 import struct
-import subprocess
 import sys
 import unittest
 
-from cli_util import (CPU_EXTRACTION, CPU_MATCHING, SKIP_EXIT_CODE, Database,
-                      TempDirTestCase, read_text_model, run_colmap)
+from cli_util import SKIP_EXIT_CODE, Database, TempDirTestCase, require_render
+from sphera_common import (UPSTREAM_COLMAP, extract_features,
+                           match_exhaustive, read_text_model, run_colmap,
+                           run_program, run_render)
 
-RENDER = os.environ.get("SPHERA_RENDER", "")
-UPSTREAM = os.environ.get(
-    "SPHERA_UPSTREAM_COLMAP",
-    os.path.expanduser(
-        "~/.cache/sphera-peers/colmap4/build/src/colmap/exe/colmap"))
+UPSTREAM = os.environ.get("SPHERA_UPSTREAM_COLMAP", UPSTREAM_COLMAP)
 HAVE_UPSTREAM = os.path.exists(UPSTREAM)
 NEEDS_UPSTREAM = unittest.skipUnless(
     HAVE_UPSTREAM,
@@ -30,14 +27,7 @@ NEEDS_UPSTREAM = unittest.skipUnless(
 
 
 def run_upstream(*args):
-    result = subprocess.run([UPSTREAM, *map(str, args)],
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True, timeout=1800)
-    if result.returncode != 0:
-        raise AssertionError(f"upstream colmap {' '.join(map(str, args))} "
-                             f"exited {result.returncode}:\n"
-                             f"{result.stdout[-4000:]}")
-    return result
+    return run_program(UPSTREAM, *args, name="upstream colmap")
 
 
 def write_text_model(path):
@@ -184,19 +174,15 @@ class InterchangeTest(TempDirTestCase):
 
     def render_panoramas(self):
         scene = self.path("room")
-        subprocess.run([RENDER, "--output", scene, "--seed", "3", "--layout",
-                        "room9", "--model", "EQUIRECTANGULAR", "--width",
-                        "1024", "--height", "512", "--supersample", "2"],
-                       check=True, stdout=subprocess.DEVNULL)
+        run_render(scene, "--seed", "3", "--layout", "room9", "--model",
+                   "EQUIRECTANGULAR", "--width", "1024", "--height", "512",
+                   "--supersample", "2")
         return os.path.join(scene, "images")
 
     def features_and_matches(self, program, images, database):
-        program("feature_extractor", "--database_path", database,
-                "--image_path", images, "--ImageReader.camera_model",
-                "EQUIRECTANGULAR", "--ImageReader.single_camera", "1",
-                *CPU_EXTRACTION)
-        program("exhaustive_matcher", "--database_path", database,
-                *CPU_MATCHING)
+        extract_features(database, images, "EQUIRECTANGULAR",
+                         program=program)
+        match_exhaustive(database, program=program)
 
     def mapped_images(self, program, images, database, name):
         output = self.path(name)
@@ -254,8 +240,7 @@ class InterchangeTest(TempDirTestCase):
 
 
 if __name__ == "__main__":
-    if not os.path.exists(RENDER):
-        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
+    require_render()
     if not HAVE_UPSTREAM:
         print(f"note: upstream COLMAP not at {UPSTREAM}; the tests against it "
               "are skipped (build it with ../shared/peers/build_colmap4.sh)")

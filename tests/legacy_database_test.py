@@ -5,8 +5,8 @@ keypoint, descriptor, match and verified geometry
 import os
 import shutil
 
-from cli_util import (SHARED_DATA, Database, TempDirTestCase, main_with_skip,
-                      run_colmap)
+from cli_util import SHARED_DATA, Database, TempDirTestCase, main_with_skip
+from sphera_common import run_colmap
 
 LEGACY = os.path.join(SHARED_DATA, "colmap_legacy")
 

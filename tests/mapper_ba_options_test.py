@@ -9,14 +9,12 @@ import json
 import os
 import re
 import shutil
-import subprocess
 import tempfile
-import unittest
 
-from cli_util import (CPU_EXTRACTION, CPU_MATCHING, TempDirTestCase,
-                      read_text_model, run_colmap)
-
-RENDER = os.environ.get("SPHERA_RENDER", "")
+from cli_util import TempDirTestCase, main_with_render
+from sphera_common import (extract_features, match_exhaustive,
+                           model_to_text, read_text_model, run_colmap,
+                           run_render)
 
 
 class MapperBAOptionsTest(TempDirTestCase):
@@ -24,19 +22,13 @@ class MapperBAOptionsTest(TempDirTestCase):
     def setUpClass(cls):
         cls.shared = tempfile.mkdtemp(prefix="sphera_test_")
         cls.scene = os.path.join(cls.shared, "scene")
-        subprocess.run([RENDER, "--output", cls.scene, "--layout", "room9",
-                        "--model", "EQUIRECTANGULAR", "--width", "1024",
-                        "--height", "512", "--supersample", "2", "--seed",
-                        "11"], check=True, stdout=subprocess.DEVNULL)
+        run_render(cls.scene, "--layout", "room9", "--model",
+                   "EQUIRECTANGULAR", "--width", "1024", "--height", "512",
+                   "--supersample", "2", "--seed", "11")
         cls.images = os.path.join(cls.scene, "images")
         cls.database = os.path.join(cls.shared, "database.db")
-        run_colmap("feature_extractor", "--database_path", cls.database,
-                   "--image_path", cls.images,
-                   "--ImageReader.camera_model", "EQUIRECTANGULAR",
-                   "--ImageReader.single_camera", "1",
-                   *CPU_EXTRACTION)
-        run_colmap("exhaustive_matcher", "--database_path", cls.database,
-                   *CPU_MATCHING)
+        extract_features(cls.database, cls.images, "EQUIRECTANGULAR")
+        match_exhaustive(cls.database)
 
     @classmethod
     def tearDownClass(cls):
@@ -65,11 +57,7 @@ class MapperBAOptionsTest(TempDirTestCase):
         os.makedirs(output)
         run_colmap("bundle_adjuster", "--input_path", model, "--output_path",
                    output, "--BundleAdjustment.sphere_residual", residual)
-        text = output + "_txt"
-        os.makedirs(text)
-        run_colmap("model_converter", "--input_path", output, "--output_path",
-                   text, "--output_type", "TXT")
-        _, images, _ = read_text_model(text)
+        _, images, _ = read_text_model(model_to_text(output, output + "_txt"))
         return {fields[9]: [float(v) for v in fields[1:8]]
                 for fields, _ in images.values()}
 
@@ -133,6 +121,4 @@ class MapperBAOptionsTest(TempDirTestCase):
 
 
 if __name__ == "__main__":
-    if not os.path.exists(RENDER):
-        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
-    unittest.main()
+    main_with_render()

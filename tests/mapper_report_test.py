@@ -4,13 +4,12 @@ no verified pair, no pose), a split into several models is pointed out, and a
 run that makes no model exits non-zero with the same report."""
 import os
 import re
-import subprocess
-import unittest
 
-from cli_util import (CPU_EXTRACTION, CPU_MATCHING, Database, TempDirTestCase,
-                      run_colmap, write_noise_image)
+from cli_util import (Database, TempDirTestCase, main_with_render,
+                      write_noise_image)
+from sphera_common import (extract_features, match_exhaustive, run_colmap,
+                           run_render)
 
-RENDER = os.environ.get("SPHERA_RENDER", "")
 WIDTH, HEIGHT = 640, 480
 
 
@@ -23,14 +22,9 @@ def write_blank_image(path):
 class MapperReportTest(TempDirTestCase):
     def extract_and_match(self, image_path):
         database = self.path("database.db")
-        run_colmap("feature_extractor", "--database_path", database,
-                   "--image_path", image_path,
-                   "--ImageReader.camera_model", "PINHOLE",
-                   "--ImageReader.camera_params", "320,320,320,240",
-                   "--ImageReader.single_camera", "1",
-                   *CPU_EXTRACTION)
-        run_colmap("exhaustive_matcher", "--database_path", database,
-                   *CPU_MATCHING)
+        extract_features(database, image_path, "PINHOLE",
+                         params=[320, 320, 320, 240])
+        match_exhaustive(database)
         return database
 
     def run_mapper(self, database, image_path, output="sparse",
@@ -53,9 +47,8 @@ class MapperReportTest(TempDirTestCase):
         # Two arcs of the outward-looking ring (8 and 4 views) that see
         # opposite walls and share no view: two models.
         scene = self.path("scene")
-        subprocess.run([RENDER, "--output", scene, "--layout", "ring",
-                        "--supersample", "2", "--seed", "3"],
-                       check=True, stdout=subprocess.DEVNULL)
+        run_render(scene, "--layout", "ring", "--supersample", "2", "--seed",
+                   "3")
         names = sorted(os.listdir(os.path.join(scene, "images")))
         self.assertEqual(len(names), 16)
         os.makedirs(images)
@@ -122,6 +115,4 @@ class MapperReportTest(TempDirTestCase):
 
 
 if __name__ == "__main__":
-    if not os.path.exists(RENDER):
-        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
-    unittest.main()
+    main_with_render()

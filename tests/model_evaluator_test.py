@@ -6,29 +6,11 @@ import os
 import random
 import shutil
 
-from cli_util import SHARED_DATA, TempDirTestCase, pose_errors, run_colmap
+from cli_util import SHARED_DATA, TempDirTestCase
+from sphera_common import (axis_angle_quat, pose_errors, quat_mul,
+                           quat_rotate, run_colmap)
 
 import unittest
-
-
-def quat_mul(a, b):
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    return (aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw)
-
-
-def quat_rotate(q, v):
-    w, x, y, z = quat_mul(quat_mul(q, (0.0, *v)), (q[0], -q[1], -q[2], -q[3]))
-    return (x, y, z)
-
-
-def axis_angle_quat(axis, angle):
-    norm = math.sqrt(sum(a * a for a in axis))
-    s = math.sin(angle / 2) / norm
-    return (math.cos(angle / 2), axis[0] * s, axis[1] * s, axis[2] * s)
 
 
 class Pose:

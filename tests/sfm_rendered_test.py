@@ -4,33 +4,16 @@ seen by 9 equirectangular cameras, and a hybrid set of equirectangular,
 190° fisheye and pinhole cameras."""
 import json
 import os
-import subprocess
-import sys
-import unittest
 
-from cli_util import CPU_EXTRACTION, CPU_MATCHING, TempDirTestCase, run_colmap
-
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                                "..", "scripts"))
-from benchmark_sfm import hybrid_rig  # noqa: E402  (the benchmark's rig)
-
-RENDER = os.environ.get("SPHERA_RENDER", "")
+from cli_util import TempDirTestCase, main_with_render
+from sphera_common import (extract_features, hybrid_rig, match_exhaustive,
+                           model_to_text, read_text_cameras,
+                           read_text_images, run_colmap, run_render,
+                           write_rig)
 
 
 def render(output, *args):
-    subprocess.run([RENDER, "--output", output, "--seed", "7", *map(str, args)],
-                   check=True, stdout=subprocess.DEVNULL)
-
-
-def read_cameras(model_path):
-    cameras = {}
-    with open(os.path.join(model_path, "cameras.txt")) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            fields = line.split()
-            cameras[int(fields[0])] = (fields[1], fields[4:])
-    return cameras
+    run_render(output, "--seed", "7", *args)
 
 
 class RenderedSfMTest(TempDirTestCase):
@@ -41,25 +24,16 @@ class RenderedSfMTest(TempDirTestCase):
             list_path = self.path(f"list{index}.txt")
             with open(list_path, "w") as f:
                 f.write("\n".join(names) + "\n")
-            run_colmap("feature_extractor", "--database_path", database,
-                       "--image_path", os.path.join(scene, "images"),
-                       "--image_list_path", list_path,
-                       "--ImageReader.camera_model", model,
-                       "--ImageReader.camera_params", ",".join(params),
-                       "--ImageReader.single_camera", "1",
-                       *CPU_EXTRACTION)
-        run_colmap("exhaustive_matcher", "--database_path", database,
-                   *CPU_MATCHING)
+            extract_features(database, os.path.join(scene, "images"), model,
+                             "--image_list_path", list_path, params=params)
+        match_exhaustive(database)
         os.makedirs(self.path("sparse"))
         run_colmap("mapper", "--database_path", database, "--image_path",
                    os.path.join(scene, "images"), "--output_path",
                    self.path("sparse"))
         models = sorted(os.listdir(self.path("sparse")))
         self.assertEqual(models, ["0"], "the images split into several models")
-        os.makedirs(self.path("sparse_txt"))
-        run_colmap("model_converter", "--input_path", self.path("sparse", "0"),
-                   "--output_path", self.path("sparse_txt"), "--output_type",
-                   "TXT")
+        model_to_text(self.path("sparse", "0"), self.path("sparse_txt"))
         os.makedirs(self.path("eval"))
         run_colmap("model_evaluator", "--gt_path",
                    os.path.join(scene, "sparse_gt"), "--input_path",
@@ -74,14 +48,12 @@ class RenderedSfMTest(TempDirTestCase):
 
     def gt_image_lists(self, scene):
         """Groups the ground-truth images by camera: [(model, params, names)]."""
-        cameras = read_cameras(os.path.join(scene, "sparse_gt"))
+        gt = os.path.join(scene, "sparse_gt")
+        cameras = read_text_cameras(gt)
         groups = {}
-        with open(os.path.join(scene, "sparse_gt", "images.txt")) as f:
-            lines = [l for l in f if not l.startswith("#")]
-        for line in lines[::2]:
-            fields = line.split()
+        for fields, _ in read_text_images(gt).values():
             groups.setdefault(int(fields[8]), []).append(fields[9])
-        return [(cameras[camera_id][0], cameras[camera_id][1], names)
+        return [(cameras[camera_id][0], cameras[camera_id][3], names)
                 for camera_id, names in sorted(groups.items())]
 
     def test_paper_room_nine_equirectangular_cameras(self):
@@ -107,8 +79,7 @@ class RenderedSfMTest(TempDirTestCase):
         # 4 panoramas, 4 fisheye 190 degrees, 4 pinhole (the SfM benchmark's
         # room_hybrid rig), with the mapper's default intrinsics refinement.
         rig = self.path("hybrid_rig.txt")
-        with open(rig, "w") as f:
-            f.write("\n".join(hybrid_rig()) + "\n")
+        write_rig(rig, hybrid_rig())
         scene = self.path("hybrid")
         render(scene, "--rig", rig, "--supersample", 2)
         result = self.reconstruct(scene, self.gt_image_lists(scene))
@@ -117,10 +88,10 @@ class RenderedSfMTest(TempDirTestCase):
         self.assertEqual(result["num_registered"], 12)
         # Registration must not refine the panoramas' w, h (their image
         # size); when it did, the panoramas were off by up to 0.2 degrees.
-        cameras = read_cameras(self.path("sparse_txt"))
-        equirect = [params for model, params in cameras.values()
+        cameras = read_text_cameras(self.path("sparse_txt"))
+        equirect = [params for model, _, _, params in cameras.values()
                     if model == "EQUIRECTANGULAR"]
-        self.assertEqual(equirect, [["2048", "1024"]])
+        self.assertEqual(equirect, [[2048.0, 1024.0]])
         # Measured here: mean 0.017, max 0.076 degrees (with the w, h drift:
         # mean 0.06, max 0.2).
         self.assertLess(result["mean_rotation_error_deg"], 0.03)
@@ -142,6 +113,4 @@ class RenderedSfMTest(TempDirTestCase):
 
 
 if __name__ == "__main__":
-    if not os.path.exists(RENDER):
-        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
-    unittest.main()
+    main_with_render()

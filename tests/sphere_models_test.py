@@ -6,30 +6,21 @@ registered, the poses agree with the ground truth, and the model holds points
 that are seen behind a lens plane (rays upstream's models cannot represent).
 """
 import os
-import subprocess
-import sys
-import unittest
 
 import numpy as np
 
-from cli_util import (CPU_EXTRACTION, CPU_MATCHING, TempDirTestCase,
-                      pose_errors, read_text_model, rotation_from_quaternion,
-                      run_colmap)
-
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                                "..", "scripts"))
-from benchmark_sfm import fisheye190_rig, rig_line  # noqa: E402
-
-RENDER = os.environ.get("SPHERA_RENDER", "")
+from cli_util import TempDirTestCase, main_with_render
+from sphera_common import (cam_from_world, extract_features, fisheye190_rig,
+                           match_exhaustive, model_to_text, pose_errors,
+                           read_text_model, rig_line, run_colmap, run_render,
+                           write_rig)
 
 
 def render(output, rig_lines, supersample=2):
     rig = output + "_rig.txt"
-    with open(rig, "w") as f:
-        f.write("\n".join(rig_lines) + "\n")
-    subprocess.run([RENDER, "--output", output, "--seed", "7", "--rig", rig,
-                    "--supersample", str(supersample)],
-                   check=True, stdout=subprocess.DEVNULL)
+    write_rig(rig, rig_lines)
+    run_render(output, "--seed", "7", "--rig", rig, "--supersample",
+               supersample)
 
 
 def ring_of_200_degree_lenses(model, params):
@@ -45,14 +36,9 @@ def ring_of_200_degree_lenses(model, params):
 class SphereModelsOnColmap4Test(TempDirTestCase):
     def reconstruct(self, scene, model, params, mapper="mapper"):
         database = self.path("database.db")
-        run_colmap("feature_extractor", "--database_path", database,
-                   "--image_path", os.path.join(scene, "images"),
-                   "--ImageReader.camera_model", model,
-                   "--ImageReader.camera_params", ",".join(map(str, params)),
-                   "--ImageReader.single_camera", "1",
-                   *CPU_EXTRACTION)
-        run_colmap("exhaustive_matcher", "--database_path", database,
-                   *CPU_MATCHING)
+        extract_features(database, os.path.join(scene, "images"), model,
+                         params=params)
+        match_exhaustive(database)
         os.makedirs(self.path("sparse"))
         run_colmap(mapper, "--database_path", database, "--image_path",
                    os.path.join(scene, "images"), "--output_path",
@@ -60,11 +46,7 @@ class SphereModelsOnColmap4Test(TempDirTestCase):
         models = sorted(name for name in os.listdir(self.path("sparse"))
                         if os.path.isdir(self.path("sparse", name)))
         self.assertEqual(models, ["0"], "the images split into several models")
-        os.makedirs(self.path("sparse_txt"))
-        run_colmap("model_converter", "--input_path", self.path("sparse", "0"),
-                   "--output_path", self.path("sparse_txt"), "--output_type",
-                   "TXT")
-        return self.path("sparse_txt")
+        return model_to_text(self.path("sparse", "0"), self.path("sparse_txt"))
 
     def points_behind_lens_plane(self, model_path):
         """Observations whose 3D point lies behind the observing lens's
@@ -72,8 +54,7 @@ class SphereModelsOnColmap4Test(TempDirTestCase):
         _, images, points = read_text_model(model_path)
         count = 0
         for fields, observations in images.values():
-            rotation = rotation_from_quaternion(*map(float, fields[1:5]))
-            translation = np.array([float(v) for v in fields[5:8]])
+            rotation, translation = cam_from_world(fields)
             for _, _, point3D_id in observations:
                 if point3D_id >= 0:
                     xyz = np.array(points[point3D_id][0])
@@ -120,10 +101,9 @@ class SphereModelsOnColmap4Test(TempDirTestCase):
 
     def test_global_mapper_equirectangular_room(self):
         scene = self.path("room9")
-        subprocess.run([RENDER, "--output", scene, "--seed", "7", "--layout",
-                        "room9", "--model", "EQUIRECTANGULAR", "--width",
-                        "2048", "--height", "1024", "--supersample", "2"],
-                       check=True, stdout=subprocess.DEVNULL)
+        run_render(scene, "--seed", "7", "--layout", "room9", "--model",
+                   "EQUIRECTANGULAR", "--width", "2048", "--height", "1024",
+                   "--supersample", "2")
         model_path = self.reconstruct(scene, "EQUIRECTANGULAR", [2048, 1024],
                                       mapper="global_mapper")
         errors = pose_errors(os.path.join(scene, "sparse_gt"), model_path)
@@ -153,6 +133,4 @@ class SphereModelsOnColmap4Test(TempDirTestCase):
 
 
 if __name__ == "__main__":
-    if not os.path.exists(RENDER):
-        raise SystemExit(f"SPHERA_RENDER={RENDER!r} is not the built renderer")
-    unittest.main()
+    main_with_render()

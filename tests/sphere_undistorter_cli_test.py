@@ -7,8 +7,9 @@ import random
 import struct
 import zlib
 
-import cli_util
-from cli_util import TempDirTestCase, run_colmap
+import sphera_common
+from cli_util import TempDirTestCase
+from sphera_common import mat_vec, model_to_text, rotation_matrix, run_colmap
 
 import unittest
 
@@ -36,15 +37,6 @@ def write_png(path, width, height, pixel):
 def texture(x, y):
     return int(128 + 60 * math.sin(x * 0.11) * math.cos(y * 0.07) +
                40 * math.sin((x + 2 * y) * 0.031)) & 0xFF
-
-
-def rotate(q, v):
-    """Rotates v by the unit quaternion q = (w, x, y, z)."""
-    w, x, y, z = q
-    r = [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
-    return [sum(r[i][j] * v[j] for j in range(3)) for i in range(3)]
 
 
 def equirect_pixel(ray, width, height):
@@ -80,7 +72,7 @@ def write_scene(root, num_points=60, seed=4):
     for image_id, (q, t) in enumerate(POSES, start=1):
         points2d = []
         for j, p in enumerate(points):
-            xc = [a + b for a, b in zip(rotate(q, p), t)]
+            xc = [a + b for a, b in zip(mat_vec(rotation_matrix(*q), p), t)]
             u, v = equirect_pixel(xc, PANO_W, PANO_H)
             tracks[j + 1].append((image_id, len(points2d)))
             points2d.append(f"{u!r} {v!r} {j + 1}")
@@ -109,7 +101,7 @@ def write_scene(root, num_points=60, seed=4):
 def read_text_model(path):
     """cameras, images {name: (camera_id, [(x, y, point3D_id)])}, points
     {id: track length} of a text model."""
-    cameras, images, points = cli_util.read_text_model(path)
+    cameras, images, points = sphera_common.read_text_model(path)
     return (cameras,
             {fields[9]: (int(fields[8]), observations)
              for fields, observations in images.values()},
@@ -141,11 +133,8 @@ class SphereUndistorterTest(TempDirTestCase):
                           output, *extra, check=check)
 
     def to_text(self, sparse):
-        text = self.path("text_" + str(len(os.listdir(self.tmp))))
-        os.makedirs(text)
-        run_colmap("model_converter", "--input_path", sparse, "--output_path",
-                   text, "--output_type", "TXT")
-        return read_text_model(text)
+        return read_text_model(model_to_text(
+            sparse, self.path("text_" + str(len(os.listdir(self.tmp))))))
 
     def assert_nothing_left(self, output):
         self.assertFalse(os.path.exists(output), output)
