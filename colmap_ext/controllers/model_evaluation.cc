@@ -6,6 +6,7 @@
 #include "colmap/math/math.h"
 #include "colmap/util/logging.h"
 #include "colmap/util/string.h"
+#include "colmap_ext/controllers/sphere_bundle_adjustment.h"
 #include "estimators/similarity_alignment.h"
 
 #include <algorithm>
@@ -257,43 +258,22 @@ ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
   evaluation.mean_position_error_normalized /= evaluation.num_registered;
 
   // Angular reprojection error over all observations, per camera too.
-  std::map<camera_t, CameraEvaluation> cameras;
-  for (const auto& [point3D_id, point3D] : reconstruction.Points3D()) {
-    for (const TrackElement& element : point3D.track.Elements()) {
-      const Image& image = reconstruction.Image(element.image_id);
-      const Camera& camera = reconstruction.Camera(image.CameraId());
-      const std::optional<Eigen::Vector3d> ray_in_cam =
-          camera.CamRayFromImg(image.Point2D(element.point2D_idx).xy);
-      if (!ray_in_cam) {
-        continue;
-      }
-      const Eigen::Vector3d point_in_cam = image.CamFromWorld() * point3D.xyz;
-      const double angle = std::atan2(ray_in_cam->cross(point_in_cam).norm(),
-                                      ray_in_cam->dot(point_in_cam));
-      CameraEvaluation& camera_evaluation = cameras[camera.camera_id];
-      camera_evaluation.camera_id = camera.camera_id;
-      camera_evaluation.model_name = camera.ModelName();
-      camera_evaluation.num_observations += 1;
-      camera_evaluation.mean_angular_error_rad += angle;
-      camera_evaluation.mean_angular_error_px +=
-          angle / camera.CamFromImgThreshold(1.0);
-      evaluation.num_observations += 1;
-      evaluation.mean_angular_error_rad += angle;
-      evaluation.mean_angular_error_px +=
-          angle / camera.CamFromImgThreshold(1.0);
-    }
-  }
-  for (auto& [camera_id, camera_evaluation] : cameras) {
-    camera_evaluation.mean_angular_error_rad /=
-        camera_evaluation.num_observations;
-    camera_evaluation.mean_angular_error_px /=
-        camera_evaluation.num_observations;
+  for (const auto& [camera_id, error] :
+       AngularErrorsByCamera(reconstruction)) {
+    CameraEvaluation camera_evaluation;
+    camera_evaluation.camera_id = camera_id;
+    camera_evaluation.model_name = reconstruction.Camera(camera_id).ModelName();
+    camera_evaluation.num_observations = error.num_observations;
+    camera_evaluation.mean_angular_error_rad =
+        error.sum_rad / error.num_observations;
+    camera_evaluation.mean_angular_error_px =
+        error.sum_px / error.num_observations;
     evaluation.cameras.push_back(camera_evaluation);
   }
-  if (evaluation.num_observations > 0) {
-    evaluation.mean_angular_error_rad /= evaluation.num_observations;
-    evaluation.mean_angular_error_px /= evaluation.num_observations;
-  }
+  MeanAngularError(reconstruction,
+                   &evaluation.num_observations,
+                   &evaluation.mean_angular_error_rad,
+                   &evaluation.mean_angular_error_px);
 
   // 3D point error against the ground-truth range maps: the true surface
   // point on the observed ray of a ground-truth camera.

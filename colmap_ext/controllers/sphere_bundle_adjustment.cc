@@ -635,13 +635,9 @@ std::string SphereBundleAdjustmentOptions::Check() const {
 // Public functions
 ////////////////////////////////////////////////////////////////////////////////
 
-void MeanAngularError(const Reconstruction& reconstruction,
-                      size_t* num_observations,
-                      double* mean_rad,
-                      double* mean_px) {
-  size_t n = 0;
-  double sum_rad = 0;
-  double sum_px = 0;
+std::map<camera_t, AngularErrorSum> AngularErrorsByCamera(
+    const Reconstruction& reconstruction) {
+  std::map<camera_t, AngularErrorSum> errors;
   for (const auto& [point3D_id, point3D] : reconstruction.Points3D()) {
     for (const TrackElement& el : point3D.track.Elements()) {
       const Image& image = reconstruction.Image(el.image_id);
@@ -652,14 +648,29 @@ void MeanAngularError(const Reconstruction& reconstruction,
       if (!ray.has_value()) continue;
       const double angle = sphera::AngleBetweenRays(
           *ray, image.CamFromWorld() * point3D.xyz);
-      sum_rad += angle;
-      sum_px += angle / RadiansPerPixel(camera);
-      ++n;
+      AngularErrorSum& error = errors[camera.camera_id];
+      error.num_observations += 1;
+      error.sum_rad += angle;
+      error.sum_px += angle / RadiansPerPixel(camera);
     }
   }
+  return errors;
+}
+
+void MeanAngularError(const Reconstruction& reconstruction,
+                      size_t* num_observations,
+                      double* mean_rad,
+                      double* mean_px) {
+  AngularErrorSum total;
+  for (const auto& [camera_id, error] : AngularErrorsByCamera(reconstruction)) {
+    total.num_observations += error.num_observations;
+    total.sum_rad += error.sum_rad;
+    total.sum_px += error.sum_px;
+  }
+  const size_t n = total.num_observations;
   *num_observations = n;
-  *mean_rad = n > 0 ? sum_rad / n : 0;
-  *mean_px = n > 0 ? sum_px / n : 0;
+  *mean_rad = n > 0 ? total.sum_rad / n : 0;
+  *mean_px = n > 0 ? total.sum_px / n : 0;
 }
 
 bool SphereBundleAdjust(const SphereBundleAdjustmentOptions& options,

@@ -36,6 +36,7 @@
 
 #include "colmap/scene/reconstruction.h"
 
+#include <map>
 #include <string>
 
 namespace colmap {
@@ -83,10 +84,19 @@ struct SphereBundleAdjustmentSummary {
   double seconds = 0;
 };
 
-// Mean angle between the observed rays (Camera::CamRayFromImg) and the
+// The angles between the observed rays (Camera::CamRayFromImg) and the
 // directions of the points, over every observation of every 3D point in a
-// registered image, in radians and in pixel equivalents (per camera radians
-// per pixel).
+// registered image, summed per camera in radians and in pixel equivalents
+// (the camera's radians per pixel, Camera::CamFromImgThreshold(1)).
+struct AngularErrorSum {
+  size_t num_observations = 0;
+  double sum_rad = 0;
+  double sum_px = 0;
+};
+std::map<camera_t, AngularErrorSum> AngularErrorsByCamera(
+    const Reconstruction& reconstruction);
+
+// Their mean over all cameras.
 void MeanAngularError(const Reconstruction& reconstruction,
                       size_t* num_observations,
                       double* mean_rad,
