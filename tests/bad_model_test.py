@@ -1,0 +1,158 @@
+"""Damaged model files: every reading command reports the damaged file in a
+one-line error and exits with 1; no abort, no signal, no hang, the input
+untouched and nothing written.
+
+The corpus is made here from a small valid model (two cameras, four images,
+points with tracks, in COLMAP's binary format): each of its five files
+(rigs, cameras, frames, images, points3D) truncated at nine places and to
+nothing, its leading count raised by one and set to 2^62 (a size that must
+not be allocated), and replaced by random bytes of the same size. Each case
+runs through `model_analyzer` and `model_converter`.
+"""
+import hashlib
+import os
+import random
+import shutil
+import struct
+import subprocess
+
+from cli_util import TempDirTestCase
+from sphera_common import COLMAP, run_colmap
+
+import unittest
+
+MODEL_FILES = ("rigs", "cameras", "frames", "images", "points3D")
+COMMANDS = ("model_analyzer", "model_converter")
+TIMEOUT_S = 60
+
+
+def write_valid_text_model(path):
+    """A small consistent model in text format at PATH."""
+    os.makedirs(path)
+    with open(os.path.join(path, "cameras.txt"), "w") as f:
+        f.write("1 PINHOLE 640 480 500 510 320 240\n")
+        f.write("2 EQUIRECTANGULAR 2048 1024 2048 1024\n")
+    rng = random.Random(5)
+    points = {}
+    observations = {image_id: [] for image_id in range(1, 5)}
+    for point_id in range(1, 41):
+        track = []
+        for image_id in rng.sample(range(1, 5), 2 + point_id % 3):
+            track.append((image_id, len(observations[image_id])))
+            observations[image_id].append(
+                (rng.uniform(10, 600), rng.uniform(10, 460), point_id))
+        points[point_id] = ((rng.uniform(-1, 1), rng.uniform(-1, 1),
+                             rng.uniform(3, 5)), track)
+    with open(os.path.join(path, "images.txt"), "w") as f:
+        for image_id in range(1, 5):
+            camera_id = 1 if image_id <= 2 else 2
+            f.write(f"{image_id} 1 0 0 0 {0.3 * image_id} 0 0 {camera_id} "
+                    f"image{image_id}.jpg\n")
+            f.write(" ".join(f"{x} {y} {p}"
+                             for x, y, p in observations[image_id]) + "\n")
+    with open(os.path.join(path, "points3D.txt"), "w") as f:
+        for point_id, (xyz, track) in points.items():
+            f.write(f"{point_id} {xyz[0]} {xyz[1]} {xyz[2]} 128 128 128 0.5 "
+                    + " ".join(f"{i} {j}" for i, j in track) + "\n")
+
+
+def damaged_binary_models(valid):
+    """[(case name, damaged file name, {file name: bytes})] from the binary
+    model VALID ({file name: bytes})."""
+    rng = random.Random(17)
+    cases = []
+    for stem in MODEL_FILES:
+        name = stem + ".bin"
+        data = valid[name]
+        variants = [("truncated to 0", b"")]
+        for k in range(1, 10):
+            cut = len(data) * k // 10
+            variants.append((f"truncated at {cut}/{len(data)}", data[:cut]))
+        count = struct.unpack("<Q", data[:8])[0]
+        variants.append(("count + 1", struct.pack("<Q", count + 1) + data[8:]))
+        variants.append(("count 2^62", struct.pack("<Q", 1 << 62) + data[8:]))
+        variants.append(("random bytes",
+                         bytes(rng.getrandbits(8) for _ in data)))
+        for label, damaged in variants:
+            files = dict(valid)
+            files[name] = damaged
+            cases.append((f"{name} {label}", name, files))
+    return cases
+
+
+def digest(path):
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+class BadModelTest(TempDirTestCase):
+    def setUp(self):
+        super().setUp()
+        write_valid_text_model(self.path("text"))
+        os.makedirs(self.path("binary"))
+        run_colmap("model_converter", "--input_path", self.path("text"),
+                   "--output_path", self.path("binary"), "--output_type",
+                   "BIN")
+        self.valid = {}
+        for stem in MODEL_FILES:
+            with open(self.path("binary", stem + ".bin"), "rb") as f:
+                self.valid[stem + ".bin"] = f.read()
+
+    def run_command(self, command, model, output):
+        if command == "model_analyzer":
+            args = ["model_analyzer", "--path", model]
+        else:
+            args = ["model_converter", "--input_path", model, "--output_path",
+                    output, "--output_type", "TXT"]
+        try:
+            result = subprocess.run([COLMAP, *args], stdout=subprocess.PIPE,
+                                    stderr=subprocess.STDOUT, text=True,
+                                    errors="replace", timeout=TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            return None, f"no exit within {TIMEOUT_S} s"
+        return result.returncode, result.stdout
+
+    def test_valid_model_reads(self):
+        for command in COMMANDS:
+            os.makedirs(self.path("out_valid_" + command))
+            code, output = self.run_command(command, self.path("binary"),
+                                            self.path("out_valid_" + command))
+            self.assertEqual(code, 0, output[-2000:])
+
+    def test_damaged_binary_files_are_named_errors(self):
+        cases = damaged_binary_models(self.valid)
+        self.assertEqual(len(cases), 5 * 13)
+        outcomes = []
+        for index, (case, damaged_name, files) in enumerate(cases):
+            model = self.path(f"case{index}")
+            os.makedirs(model)
+            for name, data in files.items():
+                with open(os.path.join(model, name), "wb") as f:
+                    f.write(data)
+            before = {name: digest(os.path.join(model, name))
+                      for name in files}
+            for command in COMMANDS:
+                output_dir = self.path(f"out{index}_{command}")
+                os.makedirs(output_dir)
+                with self.subTest(case=case, command=command):
+                    code, output = self.run_command(command, model,
+                                                    output_dir)
+                    tail = output[-1500:]
+                    outcomes.append(code)
+                    self.assertEqual(code, 1, f"{case}: exit {code}\n{tail}")
+                    self.assertIn(damaged_name, output, tail)
+                    for marker in ("terminate called", "SIGSEGV", "SIGABRT",
+                                   "Aborted"):
+                        self.assertNotIn(marker, output, tail)
+                    self.assertEqual(os.listdir(output_dir), [],
+                                     "something was written")
+            after = {name: digest(os.path.join(model, name))
+                     for name in files}
+            self.assertEqual(before, after, f"{case}: the input changed")
+            shutil.rmtree(model)
+        self.assertEqual(len(outcomes), 5 * 13 * len(COMMANDS))
+        print(f"{len(outcomes)} damaged-model runs, all named errors")
+
+
+if __name__ == "__main__":
+    unittest.main()
