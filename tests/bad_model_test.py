@@ -3,11 +3,12 @@ one-line error and exits with 1; no abort, no signal, no hang, the input
 untouched and nothing written.
 
 The corpus is made here from a small valid model (two cameras, four images,
-points with tracks, in COLMAP's binary format): each of its five files
-(rigs, cameras, frames, images, points3D) truncated at nine places and to
-nothing, its leading count raised by one and set to 2^62 (a size that must
-not be allocated), and replaced by random bytes of the same size. Each case
-runs through `model_analyzer` and `model_converter`.
+points with tracks). Binary: each of its five files (rigs, cameras, frames,
+images, points3D) truncated at nine places and to nothing, its leading count
+raised by one and set to 2^62 (a size that must not be allocated), and
+replaced by random bytes of the same size. Text: each file cut inside a
+line at five places, a value that is not a number and one that is not
+finite. Each case runs through `model_analyzer` and `model_converter`.
 """
 import hashlib
 import os
@@ -80,6 +81,40 @@ def damaged_binary_models(valid):
     return cases
 
 
+def damaged_text_models(valid):
+    """[(case name, damaged file name, {file name: bytes})] from the text
+    model VALID ({file name: bytes}): each file cut inside a line at five
+    places, and its first data line with a value that is not a number and
+    with a value that is not finite."""
+    cases = []
+    for stem in MODEL_FILES:
+        name = stem + ".txt"
+        data = valid[name]
+        lines = data.split(b"\n")
+        first = next(i for i, line in enumerate(lines)
+                     if line and not line.startswith(b"#"))
+        header = len(b"\n".join(lines[:first])) + 1
+        variants = []
+        for k in range(1, 6):
+            cut = header + (len(data) - header) * k // 6
+            while data[cut - 1:cut] in (b"\n", b" "):
+                cut -= 1
+            variants.append((f"cut inside a line at {cut}/{len(data)}",
+                             data[:cut]))
+        for label, value in (("not a number", b"abc"),
+                             ("not finite", b"nan")):
+            tokens = lines[first].split(b" ")
+            tokens[2] = value
+            damaged = lines[:first] + [b" ".join(tokens)] + lines[first + 1:]
+            variants.append((f"{label} in line {first + 1}",
+                             b"\n".join(damaged)))
+        for label, damaged in variants:
+            files = dict(valid)
+            files[name] = damaged
+            cases.append((f"{name} {label}", name, files))
+    return cases
+
+
 def digest(path):
     with open(path, "rb") as f:
         return hashlib.sha256(f.read()).hexdigest()
@@ -93,6 +128,11 @@ class BadModelTest(TempDirTestCase):
         run_colmap("model_converter", "--input_path", self.path("text"),
                    "--output_path", self.path("binary"), "--output_type",
                    "BIN")
+        # The text model as COLMAP writes it, with rigs and frames.
+        os.makedirs(self.path("text_full"))
+        run_colmap("model_converter", "--input_path", self.path("binary"),
+                   "--output_path", self.path("text_full"), "--output_type",
+                   "TXT")
         self.valid = {}
         for stem in MODEL_FILES:
             with open(self.path("binary", stem + ".bin"), "rb") as f:
@@ -119,10 +159,10 @@ class BadModelTest(TempDirTestCase):
                                             self.path("out_valid_" + command))
             self.assertEqual(code, 0, output[-2000:])
 
-    def test_damaged_binary_files_are_named_errors(self):
-        cases = damaged_binary_models(self.valid)
-        self.assertEqual(len(cases), 5 * 13)
-        outcomes = []
+    def check_named_errors(self, cases):
+        """Runs every command on every damaged model of CASES and checks
+        the outcome; returns the number of runs."""
+        runs = 0
         for index, (case, damaged_name, files) in enumerate(cases):
             model = self.path(f"case{index}")
             os.makedirs(model)
@@ -138,9 +178,16 @@ class BadModelTest(TempDirTestCase):
                     code, output = self.run_command(command, model,
                                                     output_dir)
                     tail = output[-1500:]
-                    outcomes.append(code)
+                    runs += 1
                     self.assertEqual(code, 1, f"{case}: exit {code}\n{tail}")
-                    self.assertIn(damaged_name, output, tail)
+                    # The damaged file, or the file that refers to what
+                    # the damage removed (frames.txt to a rig of a cut
+                    # rigs.txt).
+                    self.assertTrue(
+                        any(os.path.join(model, name) in output
+                            for name in files), tail)
+                    if damaged_name.endswith(".bin"):
+                        self.assertIn(damaged_name, output, tail)
                     for marker in ("terminate called", "SIGSEGV", "SIGABRT",
                                    "Aborted"):
                         self.assertNotIn(marker, output, tail)
@@ -150,9 +197,25 @@ class BadModelTest(TempDirTestCase):
                      for name in files}
             self.assertEqual(before, after, f"{case}: the input changed")
             shutil.rmtree(model)
-        self.assertEqual(len(outcomes), 5 * 13 * len(COMMANDS))
-        print(f"{len(outcomes)} damaged-model runs, all named errors")
+        return runs
 
+    def test_damaged_binary_files_are_named_errors(self):
+        cases = damaged_binary_models(self.valid)
+        self.assertEqual(len(cases), 5 * 13)
+        runs = self.check_named_errors(cases)
+        self.assertEqual(runs, 5 * 13 * len(COMMANDS))
+        print(f"{runs} runs on damaged binary models, all named errors")
+
+    def test_damaged_text_files_are_named_errors(self):
+        valid = {}
+        for stem in MODEL_FILES:
+            with open(self.path("text_full", stem + ".txt"), "rb") as f:
+                valid[stem + ".txt"] = f.read()
+        cases = damaged_text_models(valid)
+        self.assertEqual(len(cases), 5 * 7)
+        runs = self.check_named_errors(cases)
+        self.assertEqual(runs, 5 * 7 * len(COMMANDS))
+        print(f"{runs} runs on damaged text models, all named errors")
 
 if __name__ == "__main__":
     unittest.main()
