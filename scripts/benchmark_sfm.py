@@ -62,6 +62,13 @@ position errors and the extraction, matching, mapping and whole-pipeline
 SPHERA / reference (map_time_ratio, total_time_ratio, rot_err_ratio) are
 ratios of the medians. runs.csv has one row per single run.
 
+Cramér-Rao bound: for every run with ground truth, scripts/cramer_rao.py
+bounds the run's own tracks in the ground-truth poses with the pixel noise
+estimated from the model's residuals (sigma_px); rot_crb_deg and pos_crb are
+the expected mean errors at the bound (centres protocol, like the errors),
+rot_crb_ratio and pos_crb_ratio the measured mean errors over them (table:
+rot/CRB, pos/CRB; 1 is the physical limit).
+
 --mapper_options "..." adds options to SPHERA's mapper only (split like a
 shell command line); --label NAME names SPHERA's rows (default "sphera"), so
 that runs with different options land side by side in one CSV.
@@ -141,6 +148,7 @@ METRIC_KEYS = COUNT_KEYS + [
     "rot_err_mean_deg", "rot_err_max_deg", "pos_err_mean", "pos_err_max",
     "pos_err_mean_norm", "reproj_px", "point_err_mean", "point_err_median",
     "t_extract_s", "t_match_s", "t_map_s", "t_total_s",
+    "sigma_px", "rot_crb_deg", "pos_crb", "rot_crb_ratio", "pos_crb_ratio",
 ]
 SPREAD_KEYS = ["rot_err_mean_deg", "pos_err_mean", "t_extract_s", "t_match_s",
                "t_map_s", "t_total_s"]
@@ -541,6 +549,30 @@ class Benchmark:
         if depth_path and e.get("num_points_with_depth"):
             row["point_err_mean"] = e.get("mean_point_error")
             row["point_err_median"] = e.get("median_point_error")
+        self.bound(run_dir, model, gt_path, row)
+
+    def bound(self, run_dir, model, gt_path, row):
+        """The Cramér-Rao bound of the model's own tracks in the ground-truth
+        poses, with the pixel noise estimated from its residuals
+        (scripts/cramer_rao.py), and the ratios of the measured mean errors
+        to the expected mean errors at the bound (centres protocol)."""
+        import cramer_rao
+        text = os.path.join(run_dir, "eval", "text")
+        os.makedirs(text, exist_ok=True)
+        run_step("model_converter",
+                 [self.colmap, "model_converter", "--input_path", model,
+                  "--output_path", text, "--output_type", "TXT"],
+                 os.path.join(run_dir, "logs"), self.args.step_timeout)
+        try:
+            bound = cramer_rao.bound_for_reconstruction(gt_path, text)
+        except (OSError, ValueError) as error:
+            log("no Cramér-Rao bound for %s: %s" % (model, error))
+            return
+        row["sigma_px"] = bound["sigma_px_estimated"]
+        row["rot_crb_deg"] = bound["rot_expected_mean_deg"]
+        row["pos_crb"] = bound["pos_expected_mean"]
+        row["rot_crb_ratio"] = row["rot_err_mean_deg"] / row["rot_crb_deg"]
+        row["pos_crb_ratio"] = row["pos_err_mean"] / row["pos_crb"]
 
     def analyze(self, run_dir, model, row):
         """model_analyzer's mean reprojection error, for a set without
@@ -627,8 +659,8 @@ class Benchmark:
         os.makedirs(gt, exist_ok=True)
         run_step("strecha_importer",
                  [self.colmap, "strecha_importer", "--input_path", camera_dir,
-                  "--output_path", gt], os.path.join(run_dir, "logs"),
-                 self.args.step_timeout)
+                  "--output_path", gt, "--output_type", "TXT"],
+                 os.path.join(run_dir, "logs"), self.args.step_timeout)
         return image_path, [("PINHOLE", params, None)], gt
 
     def run_one(self, dataset, system, repeat=1):
@@ -833,6 +865,8 @@ TABLE_COLUMNS = [  # (header, cell of a row)
     ("map t ratio", lambda r: fmt(r.get("map_time_ratio"))),
     ("total t ratio", lambda r: fmt(r.get("total_time_ratio"))),
     ("rot ratio", lambda r: fmt(r.get("rot_err_ratio"))),
+    ("rot/CRB", lambda r: fmt(r.get("rot_crb_ratio"))),
+    ("pos/CRB", lambda r: fmt(r.get("pos_crb_ratio"))),
     ("status", lambda r: r.get("status", "")),
 ]
 

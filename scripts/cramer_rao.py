@@ -102,7 +102,6 @@ information of one camera's (omega, C) when the points are known exactly.
 import argparse
 import csv
 import math
-import os
 import sys
 import time
 
@@ -110,7 +109,8 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse
 
-from sphera_common import read_text_model, rotation_from_quaternion
+from sphera_common import (read_text_model, rotation_from_quaternion,
+                           similarity_of_centres)
 
 FD_STEP = 1e-5  # central-difference step, relative to |y|
 GAUGES = ("centers", "orientations")
@@ -613,6 +613,77 @@ def bound_for_model(model_dir, sigma, noise="pixel", gauge="centers",
     return scene_bound(scene, sigma, noise, gauge, points)
 
 
+def reconstruction_scene(gt_dir, model_dir):
+    """(scene, sigma_px) for the tracks a reconstruction found: the
+    ground-truth poses (and cameras) of the images the text model at
+    MODEL_DIR registered, matched by name; its 3D points carried into the
+    ground-truth frame by the least-squares similarity of the camera centres;
+    its observations.  sigma_px is the keypoint noise estimated from the
+    model's own pixel residuals, sum |r|^2 / (2K - (6N + 3M - 7)) (K
+    observations, N images, M points: the degrees of freedom that bundle
+    adjustment leaves to the residuals)."""
+    gt = scene_from_model(gt_dir)
+    cameras, images, points = read_text_model(model_dir)
+    gt_index = {name: j for j, name in enumerate(gt.names)}
+    common = [image_id for image_id in sorted(images)
+              if images[image_id][0][9] in gt_index]
+    if len(common) < 3:
+        raise ValueError("fewer than 3 images of %s are in the ground truth"
+                         % model_dir)
+    est_R, est_C = [], []
+    for image_id in common:
+        fields = images[image_id][0]
+        R = rotation_from_quaternion(*map(float, fields[1:5]))
+        est_R.append(R)
+        est_C.append(-R.T @ np.array([float(v) for v in fields[5:8]]))
+    est_R, est_C = np.array(est_R), np.array(est_C)
+    gt_rows = [gt_index[images[image_id][0][9]] for image_id in common]
+    scale, rotation, translation = similarity_of_centres(est_C,
+                                                         gt.C[gt_rows])
+    point_ids = sorted(points)
+    point_index = {pid: i for i, pid in enumerate(point_ids)}
+    est_X = np.array([points[pid][0] for pid in point_ids]).reshape(-1, 3)
+    obs_image, obs_point, observed = [], [], []
+    for j, image_id in enumerate(common):
+        for x, y, pid in images[image_id][1]:
+            if pid in point_index:
+                obs_image.append(j)
+                obs_point.append(point_index[pid])
+                observed.append((x, y))
+    obs_image, obs_point = np.array(obs_image), np.array(obs_point)
+    observed = np.array(observed).reshape(-1, 2)
+    # Residuals of the reconstruction itself (its poses, points, cameras).
+    residuals = np.zeros_like(observed)
+    for j, image_id in enumerate(common):
+        sel = obs_image == j
+        rays = (est_X[obs_point[sel]] - est_C[j]) @ est_R[j].T
+        camera = cameras[int(images[image_id][0][8])]
+        residuals[sel] = project(camera, rays) - observed[sel]
+    dof = 2 * len(observed) - (6 * len(common) + 3 * len(point_ids) - 7)
+    if dof <= 0:
+        raise ValueError("%s has too few observations to estimate the noise"
+                         % model_dir)
+    sigma_px = math.sqrt(float((residuals ** 2).sum()) / dof)
+    scene = Scene(gt.cameras, [gt.image_ids[j] for j in gt_rows],
+                  [gt.names[j] for j in gt_rows], gt.camera_ids[gt_rows],
+                  gt.R[gt_rows], gt.C[gt_rows], point_ids,
+                  scale * est_X @ rotation.T + translation, obs_image,
+                  obs_point)
+    return scene, sigma_px
+
+
+def bound_for_reconstruction(gt_dir, model_dir, gauge="centers",
+                             sigma_px=None):
+    """scene_bound of the reconstruction's own tracks in the ground truth
+    (reconstruction_scene), with its estimated pixel noise unless sigma_px
+    is given; the result also holds sigma_px_estimated."""
+    scene, estimated = reconstruction_scene(gt_dir, model_dir)
+    result = scene_bound(scene, sigma_px or estimated, "pixel", gauge,
+                         points=False)
+    result["sigma_px_estimated"] = estimated
+    return result
+
+
 # ---------------------------------------------------------------------------
 # Command line
 
@@ -669,19 +740,34 @@ def main(argv=None):
                         "bounded (default: centers)")
     parser.add_argument("--no_points", action="store_true",
                         help="skip the point bound")
+    parser.add_argument("--model",
+                        help="text model of a reconstruction of the scene: "
+                        "bound its own tracks in the ground-truth poses, "
+                        "pixel noise estimated from its residuals unless "
+                        "--sigma_px is given")
     parser.add_argument("--csv", help="write the per-image table here")
     args = parser.parse_args(argv)
     noise = args.noise or ("angle" if args.sigma_deg is not None
                            else "pixel")
     sigma = args.sigma_px if noise == "pixel" else args.sigma_deg
-    if sigma is None or (args.sigma_px is not None and
-                         args.sigma_deg is not None) or not sigma > 0:
+    if args.model and (noise != "pixel" or not (sigma is None or sigma > 0)):
+        parser.error("--model bounds pixel noise: give no --sigma_deg, and "
+                     "--sigma_px only to override the estimate")
+    if not args.model and (
+            sigma is None or (args.sigma_px is not None and
+                              args.sigma_deg is not None) or not sigma > 0):
         parser.error("give one positive --sigma_px (pixel noise) or "
                      "--sigma_deg (angle noise)")
     start = time.time()
     try:
-        result = bound_for_model(args.gt_model, sigma, noise, args.gauge,
-                                 not args.no_points)
+        if args.model:
+            result = bound_for_reconstruction(args.gt_model, args.model,
+                                              args.gauge, sigma)
+            print("pixel noise estimated from the model's residuals: "
+                  "%.4g px" % result["sigma_px_estimated"])
+        else:
+            result = bound_for_model(args.gt_model, sigma, noise, args.gauge,
+                                     not args.no_points)
     except (OSError, ValueError) as e:
         print("error: %s" % e, file=sys.stderr)
         return 1

@@ -231,6 +231,22 @@ def text_model_poses(path):
     return poses
 
 
+def similarity_of_centres(est_centres, gt_centres):
+    """(scale, rotation, translation) of the least-squares similarity
+    gt = scale rotation est + translation of two (N, 3) arrays of camera
+    centres (Umeyama 1991)."""
+    import numpy as np
+    gt_mean, est_mean = gt_centres.mean(0), est_centres.mean(0)
+    gt_d, est_d = gt_centres - gt_mean, est_centres - est_mean
+    u, singular, vt = np.linalg.svd(gt_d.T @ est_d / len(gt_centres))
+    sign = np.eye(3)
+    if np.linalg.det(u @ vt) < 0:
+        sign[2, 2] = -1
+    rotation = u @ sign @ vt
+    scale = np.trace(np.diag(singular) @ sign) / (est_d ** 2).sum(1).mean()
+    return scale, rotation, gt_mean - scale * rotation @ est_mean
+
+
 def pose_errors(gt_path, model_path):
     """Aligns the text model at MODEL_PATH to the one at GT_PATH by the
     least-squares similarity of the camera centres (Umeyama 1991) and returns
@@ -240,19 +256,12 @@ def pose_errors(gt_path, model_path):
     gt = text_model_poses(gt_path)
     est = text_model_poses(model_path)
     names = sorted(set(gt) & set(est))
-    gt_centres = np.array([gt[n][1] for n in names])
-    est_centres = np.array([est[n][1] for n in names])
-    gt_mean, est_mean = gt_centres.mean(0), est_centres.mean(0)
-    gt_d, est_d = gt_centres - gt_mean, est_centres - est_mean
-    u, singular, vt = np.linalg.svd(gt_d.T @ est_d / len(names))
-    sign = np.eye(3)
-    if np.linalg.det(u @ vt) < 0:
-        sign[2, 2] = -1
-    gt_from_est = u @ sign @ vt
-    scale = np.trace(np.diag(singular) @ sign) / (est_d ** 2).sum(1).mean()
+    scale, gt_from_est, translation = similarity_of_centres(
+        np.array([est[n][1] for n in names]),
+        np.array([gt[n][1] for n in names]))
     errors = {}
     for name in names:
-        centre = scale * gt_from_est @ (est[name][1] - est_mean) + gt_mean
+        centre = scale * gt_from_est @ est[name][1] + translation
         # est cam_from_world composed with est_from_gt maps gt world to cam.
         relative = gt[name][0] @ (est[name][0] @ gt_from_est.T).T
         angle = np.arccos(np.clip((np.trace(relative) - 1) / 2, -1, 1))
