@@ -7,8 +7,8 @@ points with tracks). Binary: each of its five files (rigs, cameras, frames,
 images, points3D) truncated at nine places and to nothing, its leading count
 raised by one and set to 2^62 (a size that must not be allocated), and
 replaced by random bytes of the same size. Text: each file cut inside a
-line at five places, a value that is not a number and one that is not
-finite. Each case runs through `model_analyzer` and `model_converter`.
+line at five places, without its last line, with a value that is not a
+number and one that is not finite. Each case runs through `model_analyzer` and `model_converter`.
 """
 import hashlib
 import os
@@ -84,8 +84,8 @@ def damaged_binary_models(valid):
 def damaged_text_models(valid):
     """[(case name, damaged file name, {file name: bytes})] from the text
     model VALID ({file name: bytes}): each file cut inside a line at five
-    places, and its first data line with a value that is not a number and
-    with a value that is not finite."""
+    places, without its last data line, and its first data line with a
+    value that is not a number and with a value that is not finite."""
     cases = []
     for stem in MODEL_FILES:
         name = stem + ".txt"
@@ -101,6 +101,10 @@ def damaged_text_models(valid):
                 cut -= 1
             variants.append((f"cut inside a line at {cut}/{len(data)}",
                              data[:cut]))
+        last = max(i for i, line in enumerate(lines)
+                   if line and not line.startswith(b"#"))
+        variants.append(("its last data line removed",
+                         b"\n".join(lines[:last] + lines[last + 1:])))
         for label, value in (("not a number", b"abc"),
                              ("not finite", b"nan")):
             tokens = lines[first].split(b" ")
@@ -212,9 +216,9 @@ class BadModelTest(TempDirTestCase):
             with open(self.path("text_full", stem + ".txt"), "rb") as f:
                 valid[stem + ".txt"] = f.read()
         cases = damaged_text_models(valid)
-        self.assertEqual(len(cases), 5 * 7)
+        self.assertEqual(len(cases), 5 * 8)
         runs = self.check_named_errors(cases)
-        self.assertEqual(runs, 5 * 7 * len(COMMANDS))
+        self.assertEqual(runs, 5 * 8 * len(COMMANDS))
         print(f"{runs} runs on damaged text models, all named errors")
 
 if __name__ == "__main__":
