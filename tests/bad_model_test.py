@@ -24,7 +24,7 @@ import unittest
 
 MODEL_FILES = ("rigs", "cameras", "frames", "images", "points3D")
 COMMANDS = ("model_analyzer", "model_converter")
-TIMEOUT_S = 60
+TIMEOUT_S = 180  # a hang, not a slow run: each command takes about a second
 
 
 def write_valid_text_model(path):
