@@ -109,7 +109,7 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse
 
-from sphera_common import (read_text_model, rotation_from_quaternion,
+from sphera_common import (cam_from_world, read_text_model,
                            similarity_of_centres)
 
 FD_STEP = 1e-5  # central-difference step, relative to |y|
@@ -123,10 +123,11 @@ class Scene:
     """Ground truth: cameras {id: (model, width, height, params)}; per image
     (arrays over images) ids, names, camera ids, R (N,3,3) cam_from_world,
     C (N,3) centres; points (M,3) with ids; observations as index arrays
-    obs_image, obs_point (K,) into those arrays."""
+    obs_image, obs_point (K,) into those arrays and, read from a model, the
+    observed pixels (K,2) (None otherwise)."""
 
     def __init__(self, cameras, image_ids, names, camera_ids, R, C,
-                 point_ids, points, obs_image, obs_point):
+                 point_ids, points, obs_image, obs_point, observed=None):
         self.cameras = cameras
         self.image_ids = list(image_ids)
         self.names = list(names)
@@ -137,6 +138,7 @@ class Scene:
         self.points = np.asarray(points, dtype=float).reshape(-1, 3)
         self.obs_image = np.asarray(obs_image, dtype=int)
         self.obs_point = np.asarray(obs_point, dtype=int)
+        self.observed = observed
 
     @property
     def num_images(self):
@@ -154,22 +156,23 @@ def scene_from_model(model_dir):
     point_ids = sorted(points)
     point_index = {pid: i for i, pid in enumerate(point_ids)}
     names, camera_ids, rotations, centres = [], [], [], []
-    obs_image, obs_point = [], []
+    obs_image, obs_point, observed = [], [], []
     for j, image_id in enumerate(image_ids):
         fields, observations = images[image_id]
-        R = rotation_from_quaternion(*map(float, fields[1:5]))
-        t = np.array([float(v) for v in fields[5:8]])
+        R, t = cam_from_world(fields)
         names.append(fields[9] if len(fields) > 9 else str(image_id))
         camera_ids.append(int(fields[8]))
         rotations.append(R)
         centres.append(-R.T @ t)
-        for _, _, pid in observations:
+        for x, y, pid in observations:
             if pid in point_index:
                 obs_image.append(j)
                 obs_point.append(point_index[pid])
+                observed.append((x, y))
     xyz = [points[pid][0] for pid in point_ids]
     return Scene(cameras, image_ids, names, camera_ids, rotations, centres,
-                 point_ids, xyz, obs_image, obs_point)
+                 point_ids, xyz, obs_image, obs_point,
+                 np.array(observed, dtype=float).reshape(-1, 2))
 
 
 def transform_scene(scene, Q, t, s):
@@ -325,12 +328,28 @@ def skew(v):
 # ---------------------------------------------------------------------------
 # Fisher information
 
+def observation_rays(scene):
+    """The rays y = R_j (X_i - C_j) (K,3) of every observation."""
+    return np.einsum("kab,kb->ka", scene.R[scene.obs_image],
+                     scene.points[scene.obs_point] - scene.C[scene.obs_image])
+
+
+def projections(scene):
+    """The pixels (K,2) where every observation's point projects."""
+    y = observation_rays(scene)
+    pixels = np.empty((len(y), 2))
+    cams = scene.camera_ids[scene.obs_image]
+    for camera_id in np.unique(cams):
+        sel = cams == camera_id
+        pixels[sel] = project(scene.cameras[camera_id], y[sel])
+    return pixels
+
+
 def observation_jacobians(scene, sigma, noise):
     """Whitened Jacobians of every observation: A (K,2,6) with respect to
     (omega, C) of its image, P (K,2,3) with respect to its point."""
     R = scene.R[scene.obs_image]
-    y = np.einsum("kab,kb->ka", R, scene.points[scene.obs_point] -
-                  scene.C[scene.obs_image])
+    y = observation_rays(scene)
     M = np.empty((len(y), 2, 3))
     cams = scene.camera_ids[scene.obs_image]
     for camera_id in np.unique(cams):
@@ -623,52 +642,29 @@ def reconstruction_scene(gt_dir, model_dir):
     observations, N images, M points: the degrees of freedom that bundle
     adjustment leaves to the residuals)."""
     gt = scene_from_model(gt_dir)
-    cameras, images, points = read_text_model(model_dir)
+    est = scene_from_model(model_dir)
     gt_index = {name: j for j, name in enumerate(gt.names)}
-    common = [image_id for image_id in sorted(images)
-              if images[image_id][0][9] in gt_index]
+    common = [j for j, name in enumerate(est.names) if name in gt_index]
     if len(common) < 3:
         raise ValueError("fewer than 3 images of %s are in the ground truth"
                          % model_dir)
-    est_R, est_C = [], []
-    for image_id in common:
-        fields = images[image_id][0]
-        R = rotation_from_quaternion(*map(float, fields[1:5]))
-        est_R.append(R)
-        est_C.append(-R.T @ np.array([float(v) for v in fields[5:8]]))
-    est_R, est_C = np.array(est_R), np.array(est_C)
-    gt_rows = [gt_index[images[image_id][0][9]] for image_id in common]
-    scale, rotation, translation = similarity_of_centres(est_C,
-                                                         gt.C[gt_rows])
-    point_ids = sorted(points)
-    point_index = {pid: i for i, pid in enumerate(point_ids)}
-    est_X = np.array([points[pid][0] for pid in point_ids]).reshape(-1, 3)
-    obs_image, obs_point, observed = [], [], []
-    for j, image_id in enumerate(common):
-        for x, y, pid in images[image_id][1]:
-            if pid in point_index:
-                obs_image.append(j)
-                obs_point.append(point_index[pid])
-                observed.append((x, y))
-    obs_image, obs_point = np.array(obs_image), np.array(obs_point)
-    observed = np.array(observed).reshape(-1, 2)
-    # Residuals of the reconstruction itself (its poses, points, cameras).
-    residuals = np.zeros_like(observed)
-    for j, image_id in enumerate(common):
-        sel = obs_image == j
-        rays = (est_X[obs_point[sel]] - est_C[j]) @ est_R[j].T
-        camera = cameras[int(images[image_id][0][8])]
-        residuals[sel] = project(camera, rays) - observed[sel]
-    dof = 2 * len(observed) - (6 * len(common) + 3 * len(point_ids) - 7)
+    gt_rows = [gt_index[est.names[j]] for j in common]
+    keep = np.isin(est.obs_image, common)
+    residuals = (projections(est) - est.observed)[keep]
+    dof = 2 * len(residuals) - (6 * len(common) + 3 * est.num_points - 7)
     if dof <= 0:
         raise ValueError("%s has too few observations to estimate the noise"
                          % model_dir)
     sigma_px = math.sqrt(float((residuals ** 2).sum()) / dof)
+    scale, rotation, translation = similarity_of_centres(est.C[common],
+                                                         gt.C[gt_rows])
+    row_of_image = np.full(est.num_images, -1)
+    row_of_image[common] = np.arange(len(common))
     scene = Scene(gt.cameras, [gt.image_ids[j] for j in gt_rows],
                   [gt.names[j] for j in gt_rows], gt.camera_ids[gt_rows],
-                  gt.R[gt_rows], gt.C[gt_rows], point_ids,
-                  scale * est_X @ rotation.T + translation, obs_image,
-                  obs_point)
+                  gt.R[gt_rows], gt.C[gt_rows], est.point_ids,
+                  scale * est.points @ rotation.T + translation,
+                  row_of_image[est.obs_image[keep]], est.obs_point[keep])
     return scene, sigma_px
 
 

@@ -57,62 +57,54 @@ def write_valid_text_model(path):
                     + " ".join(f"{i} {j}" for i, j in track) + "\n")
 
 
-def damaged_binary_models(valid):
-    """[(case name, damaged file name, {file name: bytes})] from the binary
-    model VALID ({file name: bytes})."""
+def binary_damages(data):
+    """[(label, damaged bytes)] of the binary model file DATA."""
+    damages = [("truncated to 0", b"")]
+    for k in range(1, 10):
+        cut = len(data) * k // 10
+        damages.append((f"truncated at {cut}/{len(data)}", data[:cut]))
+    count = struct.unpack("<Q", data[:8])[0]
+    damages.append(("count + 1", struct.pack("<Q", count + 1) + data[8:]))
+    damages.append(("count 2^62", struct.pack("<Q", 1 << 62) + data[8:]))
     rng = random.Random(17)
-    cases = []
-    for stem in MODEL_FILES:
-        name = stem + ".bin"
-        data = valid[name]
-        variants = [("truncated to 0", b"")]
-        for k in range(1, 10):
-            cut = len(data) * k // 10
-            variants.append((f"truncated at {cut}/{len(data)}", data[:cut]))
-        count = struct.unpack("<Q", data[:8])[0]
-        variants.append(("count + 1", struct.pack("<Q", count + 1) + data[8:]))
-        variants.append(("count 2^62", struct.pack("<Q", 1 << 62) + data[8:]))
-        variants.append(("random bytes",
-                         bytes(rng.getrandbits(8) for _ in data)))
-        for label, damaged in variants:
-            files = dict(valid)
-            files[name] = damaged
-            cases.append((f"{name} {label}", name, files))
-    return cases
+    damages.append(("random bytes", bytes(rng.getrandbits(8) for _ in data)))
+    return damages
 
 
-def damaged_text_models(valid):
-    """[(case name, damaged file name, {file name: bytes})] from the text
-    model VALID ({file name: bytes}): each file cut inside a line at five
-    places, without its last data line, and its first data line with a
-    value that is not a number and with a value that is not finite."""
+def text_damages(data):
+    """[(label, damaged bytes)] of the text model file DATA: cut inside a
+    line at five places, without its last data line, and its first data
+    line with a value that is not a number and one that is not finite."""
+    lines = data.split(b"\n")
+    data_lines = [i for i, line in enumerate(lines)
+                  if line and not line.startswith(b"#")]
+    first, last = data_lines[0], data_lines[-1]
+    header = len(b"\n".join(lines[:first])) + 1
+    damages = []
+    for k in range(1, 6):
+        cut = header + (len(data) - header) * k // 6
+        while data[cut - 1:cut] in (b"\n", b" "):
+            cut -= 1
+        damages.append((f"cut inside a line at {cut}/{len(data)}",
+                        data[:cut]))
+    damages.append(("its last data line removed",
+                    b"\n".join(lines[:last] + lines[last + 1:])))
+    for label, value in (("not a number", b"abc"), ("not finite", b"nan")):
+        tokens = lines[first].split(b" ")
+        tokens[2] = value
+        damages.append((f"{label} in line {first + 1}", b"\n".join(
+            lines[:first] + [b" ".join(tokens)] + lines[first + 1:])))
+    return damages
+
+
+def damaged_models(valid, extension, damages):
+    """[(case name, damaged file name, {file name: bytes})]: the model VALID
+    ({file name: bytes}) with one of its files (STEM + EXTENSION) replaced
+    by each of DAMAGES(its bytes)."""
     cases = []
     for stem in MODEL_FILES:
-        name = stem + ".txt"
-        data = valid[name]
-        lines = data.split(b"\n")
-        first = next(i for i, line in enumerate(lines)
-                     if line and not line.startswith(b"#"))
-        header = len(b"\n".join(lines[:first])) + 1
-        variants = []
-        for k in range(1, 6):
-            cut = header + (len(data) - header) * k // 6
-            while data[cut - 1:cut] in (b"\n", b" "):
-                cut -= 1
-            variants.append((f"cut inside a line at {cut}/{len(data)}",
-                             data[:cut]))
-        last = max(i for i, line in enumerate(lines)
-                   if line and not line.startswith(b"#"))
-        variants.append(("its last data line removed",
-                         b"\n".join(lines[:last] + lines[last + 1:])))
-        for label, value in (("not a number", b"abc"),
-                             ("not finite", b"nan")):
-            tokens = lines[first].split(b" ")
-            tokens[2] = value
-            damaged = lines[:first] + [b" ".join(tokens)] + lines[first + 1:]
-            variants.append((f"{label} in line {first + 1}",
-                             b"\n".join(damaged)))
-        for label, damaged in variants:
+        name = stem + extension
+        for label, damaged in damages(valid[name]):
             files = dict(valid)
             files[name] = damaged
             cases.append((f"{name} {label}", name, files))
@@ -204,7 +196,7 @@ class BadModelTest(TempDirTestCase):
         return runs
 
     def test_damaged_binary_files_are_named_errors(self):
-        cases = damaged_binary_models(self.valid)
+        cases = damaged_models(self.valid, ".bin", binary_damages)
         self.assertEqual(len(cases), 5 * 13)
         runs = self.check_named_errors(cases)
         self.assertEqual(runs, 5 * 13 * len(COMMANDS))
@@ -215,7 +207,7 @@ class BadModelTest(TempDirTestCase):
         for stem in MODEL_FILES:
             with open(self.path("text_full", stem + ".txt"), "rb") as f:
                 valid[stem + ".txt"] = f.read()
-        cases = damaged_text_models(valid)
+        cases = damaged_models(valid, ".txt", text_damages)
         self.assertEqual(len(cases), 5 * 8)
         runs = self.check_named_errors(cases)
         self.assertEqual(runs, 5 * 8 * len(COMMANDS))

@@ -427,12 +427,7 @@ class MonteCarloTest(unittest.TestCase):
     def test_bundle_adjustment_reaches_bound(self):
         scene = ring_scene(4, 100, seed=9)
         sigma = 0.5
-        exact = np.zeros((len(scene.obs_image), 2))
-        for j in range(scene.num_images):
-            sel = scene.obs_image == j
-            y = (scene.points[scene.obs_point[sel]] - scene.C[j]) @ \
-                scene.R[j].T
-            exact[sel] = crb.project(scene.cameras[1], y)
+        exact = crb.projections(scene)
         rng = np.random.default_rng(10)
         errors = {g: ([], []) for g in crb.GAUGES}
         for _ in range(100):
@@ -457,21 +452,11 @@ class MonteCarloTest(unittest.TestCase):
 # Text model
 
 
-def exact_pixels(scene):
-    """The projections (K, 2) of the scene's observations."""
-    pixels = np.zeros((len(scene.obs_image), 2))
-    for j in range(scene.num_images):
-        sel = scene.obs_image == j
-        y = (scene.points[scene.obs_point[sel]] - scene.C[j]) @ scene.R[j].T
-        pixels[sel] = crb.project(scene.cameras[scene.camera_ids[j]], y)
-    return pixels
-
-
 def write_text_model(scene, path, pixels=None):
     """COLMAP text model of the scene, POINTS2D the exact projections or
     PIXELS (K, 2), one per observation."""
     if pixels is None:
-        pixels = exact_pixels(scene)
+        pixels = crb.projections(scene)
     os.makedirs(path, exist_ok=True)
     with open(os.path.join(path, "cameras.txt"), "w") as f:
         for cid, (model, w, h, params) in scene.cameras.items():
@@ -554,7 +539,7 @@ class ReconstructionBoundTest(unittest.TestCase):
     def test_noise_and_bound_of_a_reconstruction(self):
         scene = ring_scene(4, 100, seed=21)
         sigma = 0.4
-        observed = exact_pixels(scene) + np.random.default_rng(22).normal(
+        observed = crb.projections(scene) + np.random.default_rng(22).normal(
             0, sigma, (len(scene.obs_image), 2))
         R, C, X = bundle_adjust(scene, observed)
         estimate = crb.transform_scene(

@@ -21,8 +21,8 @@
 // upstream uses analytic Jacobians (the full and the constant-pose cost), so
 // do we: AngularReprojErrorCostFunction and
 // AngularReprojErrorConstantPoseCostFunction, tested against the autodiff
-// functors; mapping a 360-degree set with the angular residual then costs
-// no more than with the pixel one.
+// AngularReprojErrorCostFunctor; mapping a 360-degree set with the angular
+// residual then costs no more than with the pixel one.
 #pragma once
 
 #include "colmap/estimators/cost_functions/quaternion_utils.h"
@@ -208,7 +208,8 @@ class AngularReprojErrorCostFunction
   const Eigen::Vector2d point2D_;
 };
 
-// AngularReprojErrorConstantPoseCostFunctor with analytic Jacobians.
+// The same with a constant pose (upstream's
+// ReprojErrorConstantPoseCostFunctor), analytic only.
 template <typename CameraModel>
 class AngularReprojErrorConstantPoseCostFunction
     : public ceres::SizedCostFunction<2, 3, CameraModel::num_params> {
@@ -284,35 +285,6 @@ class AngularReprojErrorCostFunctor
 
  private:
   const Eigen::Vector2d point2D_;
-};
-
-template <typename CameraModel>
-class AngularReprojErrorConstantPoseCostFunctor
-    : public AutoDiffCostFunctor<
-          AngularReprojErrorConstantPoseCostFunctor<CameraModel>,
-          2,
-          3,
-          CameraModel::num_params> {
- public:
-  AngularReprojErrorConstantPoseCostFunctor(const Eigen::Vector2d& point2D,
-                                            const Rigid3d& cam_from_world)
-      : point2D_(point2D), cam_from_world_(cam_from_world.ToMatrix()) {}
-
-  template <typename T>
-  bool operator()(const T* const point3D_in_world,
-                  const T* const camera_params,
-                  T* residuals) const {
-    const Eigen::Matrix<T, 3, 1> point3D_in_cam =
-        cam_from_world_.leftCols<3>().cast<T>() *
-            EigenVector3Map<T>(point3D_in_world) +
-        cam_from_world_.col(3).cast<T>();
-    return AngularReprojResidual<CameraModel>(
-        camera_params, point2D_, point3D_in_cam, residuals);
-  }
-
- private:
-  const Eigen::Vector2d point2D_;
-  const Eigen::Matrix3x4d cam_from_world_;
 };
 
 template <typename CameraModel>

@@ -3,11 +3,12 @@
 
 #include "colmap/scene/reconstruction.h"
 
+#include <algorithm>
 #include <exception>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
-#include <unordered_set>
+#include <vector>
 
 namespace colmap {
 
@@ -25,30 +26,49 @@ void ReadModelFile(const std::filesystem::path& path, Read&& read) {
 }
 
 // Throws when an image's observation refers to a 3D point that is not in the
-// model or whose track does not hold it: what a points3D file that lost
-// lines or track entries leaves behind (the readers accept each line on its
-// own).
+// model or whose track does not hold it: what a points file that lost lines
+// or track entries leaves behind (the readers accept each line on its own).
+// Adding a point sets the reference of each of its track's observations, so
+// the model is consistent when the images hold as many references as the
+// tracks hold observations; only a model that is not is searched for the
+// observation to name.
 inline void CheckPoint3DReferences(const Reconstruction& reconstruction) {
-  std::unordered_set<uint64_t> observations;
+  size_t num_references = 0;
+  for (const auto& [image_id, image] : reconstruction.Images()) {
+    num_references += image.NumPoints3D();
+  }
+  size_t num_observations = 0;
   for (const auto& [point3D_id, point3D] : reconstruction.Points3D()) {
-    for (const TrackElement& element : point3D.track.Elements()) {
-      observations.insert((static_cast<uint64_t>(element.image_id) << 32) |
-                          element.point2D_idx);
-    }
+    num_observations += point3D.track.Length();
+  }
+  if (num_references == num_observations) {
+    return;
   }
   for (const auto& [image_id, image] : reconstruction.Images()) {
     for (point2D_t idx = 0; idx < image.NumPoints2D(); ++idx) {
-      const Point2D& point2D = image.Point2D(idx);
-      if (point2D.HasPoint3D() &&
-          !observations.count((static_cast<uint64_t>(image_id) << 32) | idx)) {
+      const point3D_t point3D_id = image.Point2D(idx).point3D_id;
+      if (point3D_id == kInvalidPoint3DId) {
+        continue;
+      }
+      const std::vector<TrackElement>* track =
+          reconstruction.ExistsPoint3D(point3D_id)
+              ? &reconstruction.Point3D(point3D_id).track.Elements()
+              : nullptr;
+      if (track == nullptr ||
+          std::find(track->begin(), track->end(),
+                    TrackElement(image_id, idx)) == track->end()) {
         throw std::runtime_error(
             "image " + std::to_string(image_id) + " observation " +
             std::to_string(idx) + " refers to 3D point " +
-            std::to_string(point2D.point3D_id) +
+            std::to_string(point3D_id) +
             ", which is missing or whose track does not hold it");
       }
     }
   }
+  throw std::runtime_error(
+      "the tracks hold " + std::to_string(num_observations) +
+      " observations but the images refer to points " +
+      std::to_string(num_references) + " times (a repeated track entry)");
 }
 
 }  // namespace colmap
