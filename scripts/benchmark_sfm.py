@@ -73,13 +73,30 @@ rot/CRB, pos/CRB; 1 is the physical limit).
 shell command line); --label NAME names SPHERA's rows (default "sphera"), so
 that runs with different options land side by side in one CSV.
 
+Variants: --variant "NAME=OPTIONS" (repeatable) runs, after every SPHERA
+run, SPHERA's mapper again with these extra options on the same database
+(same matches, same seed) and scores it the same way: rows NAME with
+variant_of = the label, their extraction and matching times those of the
+SPHERA run, and the ratios variant / SPHERA of the mapping time, rotation
+and position errors (map_time_vs_label, rot_err_vs_label,
+pos_err_vs_label). This compares mapper options (angular vs pixel residual,
+camera-only vs full bundle adjustment) on identical inputs; what remains is
+the mapper's own run-to-run spread (its threads make two runs with one
+seed differ slightly). --variant_only a,b limits the variants to some sets.
+
+--reuse_extraction: feature extraction (which no seed changes) runs once per
+data set and system; the later runs start from a copy of its database and
+report its time, so that repeats cost matching and mapping only.
+
 Rendered scenes are cached in OUTPUT_DIR/scenes/<name> (OUTPUT_DIR/scenes/
 <name>_quick with --quick) and reused; delete a directory to re-render it.
 Each run works in OUTPUT_DIR/runs/<dataset>/<system>/ (<system>/run<k>/ with
 --repeats above 1: database, sparse models, evaluation.json, logs/ with
 every command's output). Results go to OUTPUT_DIR/sfm_results.csv (one row
-per data set and system), OUTPUT_DIR/runs.csv (one row per run) and
-OUTPUT_DIR/sfm_results.png; rows of earlier runs that this run did not redo
+per data set and system), OUTPUT_DIR/runs.csv (one row per run),
+OUTPUT_DIR/sfm_results.png (errors, times, time ratios) and
+OUTPUT_DIR/sfm_bound.png (every run's errors against its Cramér-Rao bound,
+by camera type, and error/bound per data set); rows of earlier runs that this run did not redo
 are kept in both CSVs unless --fresh (rows of another COLMAP base, from an
 older CSV, are dropped). Shared real data (../shared/data by default) may be
 absent: those rows are reported as skipped. A failing run is recorded in the
@@ -151,10 +168,15 @@ METRIC_KEYS = COUNT_KEYS + [
     "sigma_px", "rot_crb_deg", "pos_crb", "rot_crb_ratio", "pos_crb_ratio",
 ]
 SPREAD_KEYS = ["rot_err_mean_deg", "pos_err_mean", "t_extract_s", "t_match_s",
-               "t_map_s", "t_total_s"]
+               "t_map_s", "t_total_s", "rot_crb_ratio", "pos_crb_ratio"]
 # (median compared, ratio column): SPHERA / reference of the same base.
 RATIOS = [("t_map_s", "map_time_ratio"), ("t_total_s", "total_time_ratio"),
-          ("rot_err_mean_deg", "rot_err_ratio")]
+          ("rot_err_mean_deg", "rot_err_ratio"), ("pos_err_mean", "pos_err_ratio")]
+# (median compared, ratio column): a variant (--variant) / SPHERA's own
+# rows (--label) of the same data set.
+VARIANT_RATIOS = [("t_map_s", "map_time_vs_label"),
+                  ("rot_err_mean_deg", "rot_err_vs_label"),
+                  ("pos_err_mean", "pos_err_vs_label")]
 
 
 def with_spread(keys):
@@ -169,9 +191,11 @@ def with_spread(keys):
 
 COLUMNS = (["dataset", "system", "base", "status", "runs", "runs_ok"]
            + with_spread(METRIC_KEYS) + [ratio for _, ratio in RATIOS]
-           + ["mapper_options", "render", "timestamp"])
+           + [ratio for _, ratio in VARIANT_RATIOS]
+           + ["variant_of", "mapper_options", "render", "timestamp"])
 RUN_COLUMNS = (["dataset", "system", "base", "repeat", "seed", "status"] + METRIC_KEYS
-               + ["mapper_options", "render", "timestamp", "run_dir"])
+               + ["variant_of", "extraction_reused", "mapper_options", "render",
+                  "timestamp", "run_dir"])
 
 RENDER_SEED = 1
 DEFAULT_STEP_TIMEOUT = 3 * 3600
@@ -356,6 +380,13 @@ class Benchmark:
         self.supersample = 2 if args.quick else 3
         self.label = args.label
         self.mapper_options = shlex.split(args.mapper_options)
+        self.variants = []  # [(name, mapper options)]
+        for text in args.variant:
+            name, _, options = text.partition("=")
+            self.variants.append((name.strip(), shlex.split(options)))
+        self.variant_datasets = set(
+            [d.strip() for d in args.variant_only.split(",") if d.strip()]
+            or DATASETS)
         self.reference = REFERENCE
         self.reference_colmap = os.path.abspath(args.upstream_colmap)
         self.reference_error = None  # set when the reference is unavailable
@@ -466,25 +497,80 @@ class Benchmark:
     # -- pipeline ------------------------------------------------------------
 
     def reconstruct(self, colmap, run_dir, image_path, groups, row,
-                    mapper_options=(), seed=None):
+                    mapper_options=(), seed=None, extracted=None):
         """feature_extractor per camera group, exhaustive_matcher, mapper
         (with extra `mapper_options`) with COLMAP 4.x's option names;
         every command with the random seed `seed` unless None (COLMAP's
         default seed is 0). groups: [(model, params or None, image list or
-        None)]. Fills the times (t_total_s: their sum), num_models and
-        returns the largest model's directory."""
+        None)]. extracted: None, or the path under which the database after
+        extraction is kept for later runs (and taken from, with its time,
+        when an earlier run left it). Fills the times (t_total_s: their
+        sum), num_models and returns the largest model's directory."""
         logs = os.path.join(run_dir, "logs")
         database = os.path.join(run_dir, "database.db")
+        row["database"] = database
         timeout = self.args.step_timeout
         seeded = [] if seed is None else [SEED_OPTION, str(seed)]
+        if extracted and os.path.exists(extracted + ".json"):
+            with open(extracted + ".json") as f:
+                row["t_extract_s"] = json.load(f)["t_extract_s"]
+            shutil.copyfile(extracted, database)
+            row["extraction_reused"] = 1
+            log("reusing the extraction of %s (%.1f s)" %
+                (os.path.dirname(extracted), row["t_extract_s"]))
+        else:
+            self.extract(colmap, run_dir, database, image_path, groups, row,
+                         seeded)
+            if extracted:
+                shutil.copyfile(database, extracted)
+                with open(extracted + ".json", "w") as f:
+                    json.dump({"t_extract_s": row["t_extract_s"]}, f)
+        seconds, _ = match_exhaustive(database, *seeded,
+                                      program=self.step(colmap, logs,
+                                                        "exhaustive_matcher"))
+        row["t_match_s"] = round(seconds, 3)
+        return self.map(colmap, run_dir, database, image_path, row,
+                        mapper_options, seed)
 
-        def step(name):
-            """A `program` for extract_features and match_exhaustive: runs
-            `colmap ARGS` as the step NAME, returns (seconds, output)."""
-            def run(*args):
-                return run_step(name, [colmap, *map(str, args)], logs,
-                                timeout)
-            return run
+    def step(self, colmap, logs, name):
+        """A `program` for extract_features and match_exhaustive: runs
+        `colmap ARGS` as the step NAME, returns (seconds, output)."""
+        def run(*args):
+            return run_step(name, [colmap, *map(str, args)], logs,
+                            self.args.step_timeout)
+        return run
+
+    def map(self, colmap, run_dir, database, image_path, row, mapper_options,
+            seed):
+        """The mapper on `database` into run_dir/sparse; fills t_map_s,
+        t_total_s, num_models, registered, points and returns the largest
+        model's directory."""
+        seeded = [] if seed is None else [SEED_OPTION, str(seed)]
+        sparse = os.path.join(run_dir, "sparse")
+        os.makedirs(sparse, exist_ok=True)
+        seconds, _ = run_step("mapper",
+                              [colmap, "mapper", "--database_path", database,
+                               "--image_path", image_path, "--output_path",
+                               sparse] + seeded + list(mapper_options),
+                              os.path.join(run_dir, "logs"),
+                              self.args.step_timeout)
+        row["t_map_s"] = round(seconds, 3)
+        row["t_total_s"] = round(row["t_extract_s"] + row["t_match_s"] +
+                                 row["t_map_s"], 3)
+        models = sparse_models(sparse)
+        row["num_models"] = len(models)
+        if not models:
+            raise StepError("mapper produced no model")
+        registered, points, path = models[0]
+        row["registered"] = registered
+        row["points"] = points
+        return path
+
+    def extract(self, colmap, run_dir, database, image_path, groups, row,
+                seeded):
+        """feature_extractor per camera group into `database`; fills
+        t_extract_s."""
+        logs = os.path.join(run_dir, "logs")
 
         t_extract = 0.0
         for index, (model, params, image_list) in enumerate(groups):
@@ -501,30 +587,9 @@ class Benchmark:
             name = "feature_extractor" + ("_%d" % index if len(groups) > 1 else "")
             seconds, _ = extract_features(
                 database, image_path, model, *options, params=params or None,
-                single_camera=False, program=step(name))
+                single_camera=False, program=self.step(colmap, logs, name))
             t_extract += seconds
         row["t_extract_s"] = round(t_extract, 3)
-        seconds, _ = match_exhaustive(database, *seeded,
-                                      program=step("exhaustive_matcher"))
-        row["t_match_s"] = round(seconds, 3)
-        sparse = os.path.join(run_dir, "sparse")
-        os.makedirs(sparse, exist_ok=True)
-        seconds, _ = run_step("mapper",
-                              [colmap, "mapper", "--database_path", database,
-                               "--image_path", image_path, "--output_path",
-                               sparse] + seeded + list(mapper_options),
-                              logs, timeout)
-        row["t_map_s"] = round(seconds, 3)
-        row["t_total_s"] = round(row["t_extract_s"] + row["t_match_s"] +
-                                 row["t_map_s"], 3)
-        models = sparse_models(sparse)
-        row["num_models"] = len(models)
-        if not models:
-            raise StepError("mapper produced no model")
-        registered, points, path = models[0]
-        row["registered"] = registered
-        row["points"] = points
-        return path
 
     def evaluate(self, run_dir, model, gt_path, depth_path, row):
         out = os.path.join(run_dir, "eval")
@@ -709,14 +774,63 @@ class Benchmark:
                 raise StepError("unknown data set")
             if gt:
                 row["total"] = len(read_text_images(gt))
+            row["inputs"] = (image_path, gt, depth)
             log("%s/%s run %d: reconstructing" % (dataset, system, repeat))
             model = self.reconstruct(colmap, run_dir, image_path, groups, row,
-                                     mapper_options, seed)
-            if gt:
-                self.evaluate(run_dir, model, gt, depth, row)
-            else:
-                self.analyze(run_dir, model, row)
-                row["status"] = "ok (no ground truth)"
+                                     mapper_options, seed,
+                                     self.extracted_path(dataset, system))
+            self.score(run_dir, model, gt, depth, row)
+        except StepError as error:
+            row["status"] = str(error)
+        except Exception as error:  # keep going with the other data sets
+            row["status"] = "%s: %s" % (type(error).__name__, error)
+        return row
+
+    def score(self, run_dir, model, gt, depth, row):
+        """Errors against the ground truth `gt` (and the bound), or without
+        one model_analyzer's reprojection error."""
+        if gt:
+            self.evaluate(run_dir, model, gt, depth, row)
+        else:
+            self.analyze(run_dir, model, row)
+            row["status"] = "ok (no ground truth)"
+
+    def extracted_path(self, dataset, system):
+        """Where runs of (dataset, system) keep the database after feature
+        extraction for the next runs (--reuse_extraction), else None."""
+        if not self.args.reuse_extraction:
+            return None
+        return os.path.join(self.output_dir, "runs", dataset, system,
+                            "extracted.db")
+
+    def run_variant(self, dataset, base, name, options, repeat):
+        """SPHERA's mapper with the variant's `options` (after the label's
+        own --mapper_options) on the database of the SPHERA run `base`, with
+        its seed, scored like it; returns the variant's row (extraction and
+        matching times are those of `base`)."""
+        seed = repeat - 1 if self.args.vary_seed else None
+        options = list(self.mapper_options) + list(options)
+        row = {"dataset": dataset, "system": name, "base": BASE,
+               "repeat": repeat, "seed": "" if seed is None else seed,
+               "status": "ok", "variant_of": self.label,
+               "mapper_options": shlex.join(options), "timestamp": now(),
+               "render": base.get("render", "")}
+        try:
+            if "t_match_s" not in base or "inputs" not in base:
+                raise StepError("no matched database: %s" % base["status"])
+            image_path, gt, depth = base["inputs"]
+            run_dir = self.new_run_dir(dataset, name,
+                                       repeat if self.args.repeats > 1 else None)
+            row["run_dir"] = run_dir
+            row["total"] = base.get("total")
+            for key in ("t_extract_s", "t_match_s", "extraction_reused"):
+                if key in base:
+                    row[key] = base[key]
+            log("%s/%s run %d: mapper on %s" % (dataset, name, repeat,
+                                                 base["database"]))
+            model = self.map(self.colmap, run_dir, base["database"], image_path,
+                             row, options, seed)
+            self.score(run_dir, model, gt, depth, row)
         except StepError as error:
             row["status"] = str(error)
         except Exception as error:  # keep going with the other data sets
@@ -741,7 +855,13 @@ class Benchmark:
                 "status": "cannot: camera model %s unknown to %s" %
                           ("/".join(unknown), self.reference),
                 "timestamp": now()})
-        runs = {system: [] for system in systems}
+        for system in systems:
+            extracted = self.extracted_path(dataset, system)
+            for path in (extracted, extracted and extracted + ".json"):
+                if path and os.path.exists(path):
+                    os.remove(path)  # never an extraction of an earlier call
+        variants = self.variants if dataset in self.variant_datasets else []
+        runs = {system: [] for system in systems + [n for n, _ in variants]}
         for repeat in range(1, self.args.repeats + 1):
             for system in systems:
                 done = runs[system]
@@ -753,8 +873,17 @@ class Benchmark:
                     dataset, system, repeat, self.args.repeats, row["status"],
                     time.monotonic() - start))
                 done.append(row)
-        return ([row for system in systems for row in runs[system]],
-                [summarize(runs[system]) for system in systems] + cannot)
+                if system != self.label:
+                    continue
+                for name, options in variants:
+                    start = time.monotonic()
+                    variant = self.run_variant(dataset, row, name, options, repeat)
+                    log("%s/%s run %d/%d: %s (%.0f s)" % (
+                        dataset, name, repeat, self.args.repeats,
+                        variant["status"], time.monotonic() - start))
+                    runs[name].append(variant)
+        return ([row for rows in runs.values() for row in rows],
+                [summarize(rows) for rows in runs.values() if rows] + cannot)
 
 
 # ---------------------------------------------------------------------------
@@ -771,8 +900,8 @@ def summarize(runs):
     status that names the failed runs."""
     last = runs[-1]
     summary = {key: last.get(key, "") for key in
-               ("dataset", "system", "base", "mapper_options", "render",
-                "timestamp")}
+               ("dataset", "system", "base", "variant_of", "mapper_options",
+                "render", "timestamp")}
     ok = [r for r in runs if is_ok(r)]
     failed = [r for r in runs if not is_ok(r)]
     summary["runs"], summary["runs_ok"] = len(runs), len(ok)
@@ -803,10 +932,18 @@ def row_key(row):
 
 def add_ratios(rows):
     """SPHERA / reference of the medians in RATIOS, between rows of the same
-    base and data set."""
+    base and data set; a variant / its SPHERA label in VARIANT_RATIOS."""
     references = {row_key(r)[:2]: r for r in rows
                   if r.get("system") in REFERENCE_SYSTEMS}
+    by_key = {row_key(r): r for r in rows}
     for row in rows:
+        label = by_key.get(row_key(row)[:2] + (row.get("variant_of"),))
+        for key, ratio_key in VARIANT_RATIOS:
+            row[ratio_key] = ""
+            a = to_float(row.get(key))
+            b = to_float(label.get(key)) if label and row.get("variant_of") else None
+            if a is not None and b:
+                row[ratio_key] = a / b
         reference = None
         if row.get("system") not in REFERENCE_SYSTEMS:
             reference = references.get(row_key(row)[:2])
@@ -865,8 +1002,11 @@ TABLE_COLUMNS = [  # (header, cell of a row)
     ("map t ratio", lambda r: fmt(r.get("map_time_ratio"))),
     ("total t ratio", lambda r: fmt(r.get("total_time_ratio"))),
     ("rot ratio", lambda r: fmt(r.get("rot_err_ratio"))),
-    ("rot/CRB", lambda r: fmt(r.get("rot_crb_ratio"))),
-    ("pos/CRB", lambda r: fmt(r.get("pos_crb_ratio"))),
+    ("pos ratio", lambda r: fmt(r.get("pos_err_ratio"))),
+    ("rot/CRB", lambda r: spread_cell(r, "rot_crb_ratio")),
+    ("pos/CRB", lambda r: spread_cell(r, "pos_crb_ratio")),
+    ("vs label map/rot/pos", lambda r: "/".join(
+        fmt(r.get(k)) for _, k in VARIANT_RATIOS) if r.get("variant_of") else ""),
     ("status", lambda r: r.get("status", "")),
 ]
 
@@ -888,7 +1028,10 @@ def print_table(rows, reference):
           "angular reprojection error in pixel equivalents (equirect_flat: "
           "model_analyzer's pixels); pt err: 3D point error (m) against the "
           "rendered depth; total: extract+match+map; ratios: SPHERA / %s of "
-          "the medians." % reference)
+          "the medians; rot/CRB, pos/CRB: mean error over the expected mean "
+          "error at the Cramér-Rao bound of the run's own tracks; vs label: "
+          "a variant (same database, other mapper options) over SPHERA's "
+          "rows, map time/rotation/position." % reference)
 
 
 def write_csv(path, rows, columns):
@@ -1059,6 +1202,90 @@ def write_png(path, rows):
     return True
 
 
+def camera_type(dataset):
+    """The camera type a data set's marker stands for in the bound plot."""
+    models = DATASET_MODELS.get(dataset, [])
+    if len(models) > 1:
+        return "hybrid"
+    return {"EQUIRECTANGULAR": "equirectangular", "UNIFIED_OMNI": "fisheye 190°",
+            "PINHOLE": "perspective"}.get(models[0] if models else "", "other")
+
+
+BOUND_MARKERS = {"equirectangular": "o", "fisheye 190°": "^", "hybrid": "s",
+                 "perspective": "D", "other": "x"}
+
+
+def write_bound_png(path, runs, summaries):
+    """Error against its Cramér-Rao bound: every run as a point (colour:
+    system, marker: camera type) for rotation and position, the line of the
+    bound; and the medians of error/bound per data set and system as bars
+    with their spread."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        log("matplotlib missing (apt-get install python3-matplotlib): no PNG")
+        return False
+    runs = [r for r in runs if is_ok(r) and to_float(r.get("rot_crb_deg"))]
+    summaries = [r for r in summaries if to_float(r.get("rot_crb_ratio"))]
+    if not runs:
+        return False
+    systems = sorted({r["system"] for r in runs} | {r["system"] for r in summaries},
+                     key=system_order)
+    labels = [s for s in systems if s not in REFERENCE_SYSTEMS]
+    colours = dict(zip(labels, COLOURS))
+    colours.update({s: REFERENCE_COLOUR for s in REFERENCE_SYSTEMS})
+    fig, axes = plt.subplots(2, 2, figsize=(13, 10))
+    for ax, (error, bound, title) in zip(axes[0], (
+            ("rot_err_mean_deg", "rot_crb_deg", "rotation: mean error (deg)"),
+            ("pos_err_mean", "pos_crb", "position: mean error (m)"))):
+        values = []
+        for system in systems:
+            for kind, marker in BOUND_MARKERS.items():
+                points = [(to_float(r.get(bound)), to_float(r.get(error)))
+                          for r in runs if r["system"] == system
+                          and camera_type(r["dataset"]) == kind
+                          and to_float(r.get(bound)) and to_float(r.get(error))]
+                if not points:
+                    continue
+                values += [v for p in points for v in p]
+                ax.scatter(*zip(*points), marker=marker, s=28, alpha=0.75,
+                           facecolors="none" if system in REFERENCE_SYSTEMS
+                           else colours[system], edgecolors=colours[system],
+                           label="%s, %s" % (system_title(system), kind))
+        if values:
+            low, high = min(values) / 1.5, max(values) * 1.5
+            for factor, style in ((1, "-"), (2, "--")):
+                ax.plot([low, high], [factor * low, factor * high], style,
+                        color="black", linewidth=0.8,
+                        label="error = bound" if factor == 1 else "error = 2 x bound")
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+        ax.set_xlabel("expected mean error at the Cramér-Rao bound")
+        ax.set_ylabel("measured")
+        ax.set_title(title)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    datasets = [d for d in DATASETS if any(r["dataset"] == d for r in summaries)]
+    by_key = {(r["dataset"], r["system"]): r for r in summaries}
+    for ax, key, title in ((axes[1][0], "rot_crb_ratio", "rotation error / bound"),
+                           (axes[1][1], "pos_crb_ratio", "position error / bound")):
+        draw_bars(ax, datasets,
+                  [(system_title(s), {"color": colours[s]},
+                    [bar_value(by_key.get((d, s)), key) for d in datasets])
+                   for s in systems], False)
+        ax.axhline(1.0, color="black", linewidth=0.8)
+        ax.set_title(title + " (median, min..max)")
+        ax.legend(fontsize=7)
+    fig.suptitle("Errors against the Cramér-Rao bound of each run's own tracks "
+                 "(centres alignment)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
 def make_parser():
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -1079,6 +1306,21 @@ def make_parser():
     parser.add_argument("--mapper_options", default="",
                         help="extra options of SPHERA's mapper (not the "
                              "reference's), e.g. \"--Mapper.ba_sphere_residual PIXEL\"")
+    parser.add_argument("--variant", action="append", default=[],
+                        metavar="NAME=OPTIONS",
+                        help="after every SPHERA run, SPHERA's mapper again "
+                             "with these extra options on the same database "
+                             "(same matches, same seed): rows NAME, e.g. "
+                             "\"pixel=--Mapper.ba_sphere_residual PIXEL\"; "
+                             "may be repeated")
+    parser.add_argument("--variant_only", default="",
+                        help="comma-separated data sets that get the "
+                             "variants (default: all selected)")
+    parser.add_argument("--reuse_extraction", action="store_true",
+                        help="extract features once per data set and system "
+                             "and start the later runs from a copy of that "
+                             "database (their extraction time is the first "
+                             "run's); extraction does not depend on the seed")
     parser.add_argument("--label", default=DEFAULT_LABEL,
                         help="system name of SPHERA's rows (default %(default)s)")
     parser.add_argument("--output_dir", default=None,
@@ -1112,10 +1354,18 @@ def main():
             or args.label in REFERENCE_SYSTEMS):
         parser.error("--label: letters, digits and _.+- only, not %s" %
                      " or ".join(sorted(REFERENCE_SYSTEMS)))
+    names = [args.label]
+    for text in args.variant:
+        name = text.partition("=")[0].strip()
+        if ("=" not in text or not re.fullmatch(r"[A-Za-z0-9_.+-]+", name)
+                or name in names or name in REFERENCE_SYSTEMS):
+            parser.error("--variant %r: NAME=OPTIONS with a new NAME of "
+                         "letters, digits and _.+-" % text)
+        names.append(name)
     try:
         bench = Benchmark(args)
     except ValueError as error:
-        parser.error("--mapper_options: %s" % error)
+        parser.error("--mapper_options or --variant: %s" % error)
 
     if args.list:
         for name in DATASETS:
@@ -1174,6 +1424,9 @@ def main():
                           if kept_runs else ""))
     if write_png(png_path, all_rows):
         print("wrote " + png_path)
+    bound_path = os.path.join(bench.output_dir, "sfm_bound.png")
+    if write_bound_png(bound_path, all_runs, all_rows):
+        print("wrote " + bound_path)
     return 0
 
 
