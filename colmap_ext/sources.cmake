@@ -1,4 +1,4 @@
-# Sources of colmap_ext/controllers/ (and scene/) that the patch series
+# Sources of colmap_ext/controllers/ (and scene/camera_params_error) that the patch series
 # compiles into COLMAP's colmap_controllers library (the mapper and the
 # commands call them), and what they link. Included before COLMAP's CMake
 # files are read.
@@ -11,6 +11,10 @@ set(SPHERA_COLMAP_CONTROLLER_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_undistortion.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/strecha_import.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/camera_params_error.cc)
+# Sources of colmap_ext/scene/ that the patch series compiles into COLMAP's
+# colmap_scene library (the database opens through them).
+set(SPHERA_COLMAP_SCENE_SRCS
+  ${CMAKE_CURRENT_LIST_DIR}/scene/database_check.cc)
 set(SPHERA_COLMAP_CONTROLLER_LIBS
   $<BUILD_INTERFACE:sphera_estimators>
   $<BUILD_INTERFACE:opencv_core>

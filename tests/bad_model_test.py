@@ -8,7 +8,9 @@ images, points3D) truncated at nine places and to nothing, its leading count
 raised by one and set to 2^62 (a size that must not be allocated), and
 replaced by random bytes of the same size. Text: each file cut inside a
 line at five places, without its last line, with a value that is not a
-number and one that is not finite. Each case runs through `model_analyzer` and `model_converter`.
+number and one that is not finite. Binary: a camera parameter and a point
+coordinate set to NaN and to infinity. Each case runs through
+`model_analyzer` and `model_converter`.
 """
 import hashlib
 import os
@@ -212,6 +214,24 @@ class BadModelTest(TempDirTestCase):
         runs = self.check_named_errors(cases)
         self.assertEqual(runs, 5 * 8 * len(COMMANDS))
         print(f"{runs} runs on damaged text models, all named errors")
+
+    def test_non_finite_binary_values_are_named_errors(self):
+        # cameras.bin: count (8 bytes), camera_id (4), model (4), width (8),
+        # height (8), then the parameters; points3D.bin: count (8),
+        # point3D_id (8), then x, y, z.
+        nan, inf = struct.pack("<d", float("nan")), struct.pack("<d", float("inf"))
+        cases = []
+        for name, offset, value in (("cameras.bin", 32, nan),
+                                    ("cameras.bin", 40, inf),
+                                    ("points3D.bin", 16, nan),
+                                    ("points3D.bin", 32, inf)):
+            data = self.valid[name]
+            files = dict(self.valid)
+            files[name] = data[:offset] + value + data[offset + 8:]
+            cases.append((f"{name} not finite at {offset}", name, files))
+        runs = self.check_named_errors(cases)
+        self.assertEqual(runs, 4 * len(COMMANDS))
+
 
 if __name__ == "__main__":
     unittest.main()

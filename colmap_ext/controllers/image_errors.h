@@ -3,6 +3,7 @@
 // extracted, and the command exits non-zero.
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -16,7 +17,8 @@ namespace colmap {
 std::string ImageReaderCameraOptionsError(const std::string& camera_model,
                                           const std::string& camera_params);
 
-// Thread-safe; records "image_name: message".
+// Thread-safe; records "image_name: message", the first message of each
+// image only.
 void ReportImageError(const std::string& image_name, const std::string& message);
 
 std::vector<std::string> ImageErrors();
@@ -27,5 +29,17 @@ void ClearImageErrors();
 // insensitive). A file without one in an image folder (a README, a .txt) is
 // skipped, not an error.
 bool HasImageFileExtension(const std::string& path);
+
+// Why the image file at `path` cannot be read whole, or "": missing (a
+// dangling link), not a file, empty, or a JPEG or PNG whose structure ends
+// early (truncated) or is broken (overwritten bytes). Decoders read such
+// files with a warning at most and fill the missing part with gray, from
+// which features would be extracted as if it were the scene. Reads the
+// file once; does not decode it.
+std::string ImageFileError(const std::filesystem::path& path);
+
+// Reports every link under `image_path` whose target does not exist (the
+// folder listing skips them as not files).
+void ReportDanglingLinks(const std::filesystem::path& image_path);
 
 }  // namespace colmap

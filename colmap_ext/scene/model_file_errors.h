@@ -4,6 +4,7 @@
 #include "colmap/scene/reconstruction.h"
 
 #include <algorithm>
+#include <cmath>
 #include <exception>
 #include <filesystem>
 #include <stdexcept>
@@ -22,6 +23,48 @@ void ReadModelFile(const std::filesystem::path& path, Read&& read) {
     read();
   } catch (const std::exception& error) {
     throw std::runtime_error(path.string() + ": " + error.what());
+  }
+}
+
+// Throws when a camera parameter, a sensor or frame pose or a 3D point of
+// the model holds a value that is not finite (NaN, infinity): binary files
+// are read as they are, and such a value would poison every later step.
+// Called after each file is read, so that the file that brought the value
+// is the one named.
+inline void CheckFiniteValues(const Reconstruction& reconstruction) {
+  const auto finite_pose = [](const std::optional<Rigid3d>& pose) {
+    return !pose.has_value() ||
+           (pose->rotation().coeffs().allFinite() &&
+            pose->translation().allFinite());
+  };
+  for (const auto& [camera_id, camera] : reconstruction.Cameras()) {
+    for (size_t i = 0; i < camera.params.size(); ++i) {
+      if (!std::isfinite(camera.params[i])) {
+        throw std::runtime_error("camera " + std::to_string(camera_id) +
+                                 ": parameter " + std::to_string(i + 1) +
+                                 " is not finite");
+      }
+    }
+  }
+  for (const auto& [rig_id, rig] : reconstruction.Rigs()) {
+    for (const auto& [sensor_id, sensor_from_rig] : rig.NonRefSensors()) {
+      if (!finite_pose(sensor_from_rig)) {
+        throw std::runtime_error("rig " + std::to_string(rig_id) +
+                                 ": a sensor pose is not finite");
+      }
+    }
+  }
+  for (const auto& [frame_id, frame] : reconstruction.Frames()) {
+    if (!finite_pose(frame.MaybeRigFromWorld())) {
+      throw std::runtime_error("frame " + std::to_string(frame_id) +
+                               ": its pose is not finite");
+    }
+  }
+  for (const auto& [point3D_id, point3D] : reconstruction.Points3D()) {
+    if (!point3D.xyz.allFinite()) {
+      throw std::runtime_error("3D point " + std::to_string(point3D_id) +
+                               ": its position is not finite");
+    }
   }
 }
 

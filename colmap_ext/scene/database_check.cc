@@ -1,0 +1,547 @@
+#include "colmap_ext/scene/database_check.h"
+
+#include "colmap/sensor/models.h"
+#include "colmap/util/types.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include <sqlite3.h>
+
+namespace colmap {
+namespace {
+
+// What COLMAP's readers need of each table (columns of later schema
+// versions, which COLMAP adds when it migrates an older file, are not
+// required).
+const std::map<std::string, std::vector<std::string>>& RequiredColumns() {
+  static const std::map<std::string, std::vector<std::string>> kColumns = {
+      {"cameras", {"camera_id", "model", "width", "height", "params"}},
+      {"images", {"image_id", "name", "camera_id"}},
+      {"keypoints", {"image_id", "rows", "cols", "data"}},
+      {"descriptors", {"image_id", "rows", "cols", "data"}},
+      {"matches", {"pair_id", "rows", "cols", "data"}},
+      {"two_view_geometries", {"pair_id", "rows", "cols", "data", "config"}},
+      {"rigs", {"rig_id", "ref_sensor_id", "ref_sensor_type"}},
+      {"rig_sensors", {"rig_id", "sensor_id", "sensor_type"}},
+      {"frames", {"frame_id", "rig_id"}},
+      {"frame_data", {"frame_id", "data_id", "sensor_id", "sensor_type"}},
+  };
+  return kColumns;
+}
+
+// Tables that every COLMAP database since the first has: one of them
+// without the others is a damaged file, not an older one.
+const char* const kCoreTables[] = {
+    "cameras", "images", "keypoints", "descriptors", "matches"};
+
+constexpr int kSiftType = 0;  // FeatureExtractorType::SIFT
+constexpr int kCameraSensor = static_cast<int>(SensorType::CAMERA);
+constexpr int kMaxConfig = 9;  // TwoViewGeometry::CALIBRATED_RIG
+
+class ReadOnlyDatabase {
+ public:
+  explicit ReadOnlyDatabase(const std::filesystem::path& path)
+      : name_("database " + path.string()) {
+    if (sqlite3_open_v2(path.string().c_str(), &db_, SQLITE_OPEN_READONLY,
+                        nullptr) != SQLITE_OK) {
+      Fail(std::string("cannot be opened: ") +
+           (db_ ? sqlite3_errmsg(db_) : "out of memory"));
+    }
+  }
+  ~ReadOnlyDatabase() { sqlite3_close_v2(db_); }
+  ReadOnlyDatabase(const ReadOnlyDatabase&) = delete;
+  ReadOnlyDatabase& operator=(const ReadOnlyDatabase&) = delete;
+
+  [[noreturn]] void Fail(const std::string& what) const {
+    throw std::runtime_error(name_ + ": " + what);
+  }
+
+  // Runs `sql`, calling row(statement) for each result row.
+  void Query(const std::string& sql,
+             const std::function<void(sqlite3_stmt*)>& row) const {
+    sqlite3_stmt* stmt = nullptr;
+    if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &stmt, nullptr) != SQLITE_OK) {
+      const std::string message = sqlite3_errmsg(db_);
+      sqlite3_finalize(stmt);
+      Fail(DescribeSqliteError(message));
+    }
+    int rc;
+    while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) {
+      try {
+        row(stmt);
+      } catch (...) {
+        sqlite3_finalize(stmt);
+        throw;
+      }
+    }
+    const std::string message = sqlite3_errmsg(db_);
+    sqlite3_finalize(stmt);
+    if (rc != SQLITE_DONE) {
+      Fail(DescribeSqliteError(message));
+    }
+  }
+
+ private:
+  static std::string DescribeSqliteError(const std::string& message) {
+    if (message.find("not a database") != std::string::npos) {
+      return "is not an SQLite database (" + message + ")";
+    }
+    if (message.find("malformed") != std::string::npos) {
+      return "is damaged: " + message +
+             " (a truncated or partly overwritten file)";
+    }
+    if (message.find("locked") != std::string::npos) {
+      return "is locked by another process (" + message + ")";
+    }
+    return "cannot be read: " + message;
+  }
+
+  std::string name_;
+  sqlite3* db_ = nullptr;
+};
+
+int64_t Int(sqlite3_stmt* stmt, int col) {
+  return sqlite3_column_int64(stmt, col);
+}
+
+// The bytes of a blob column; NULL counts as 0.
+int64_t Bytes(sqlite3_stmt* stmt, int col) {
+  return sqlite3_column_type(stmt, col) == SQLITE_NULL
+             ? 0
+             : sqlite3_column_bytes(stmt, col);
+}
+
+std::string Text(sqlite3_stmt* stmt, int col) {
+  const unsigned char* text = sqlite3_column_text(stmt, col);
+  return text ? reinterpret_cast<const char*>(text) : "";
+}
+
+template <typename T>
+std::string Str(const T& value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+class DatabaseChecker {
+ public:
+  DatabaseChecker(const std::filesystem::path& path, int format_version)
+      : db_(path), format_version_(format_version) {}
+
+  void Run() {
+    CheckPages();
+    CheckVersion();
+    if (!CheckTables()) {
+      return;  // A new database: no tables yet.
+    }
+    CheckCameras();
+    CheckImages();
+    CheckFeatures();
+    CheckPairs("matches", false);
+    if (tables_.count("two_view_geometries")) {
+      CheckPairs("two_view_geometries", true);
+    }
+    CheckRigsAndFrames();
+  }
+
+ private:
+  void CheckPages() {
+    std::string result;
+    db_.Query("PRAGMA quick_check(1);",
+              [&](sqlite3_stmt* stmt) { result = Text(stmt, 0); });
+    if (result != "ok") {
+      std::replace(result.begin(), result.end(), '\n', ' ');
+      db_.Fail("is damaged (SQLite quick_check: " + result.substr(0, 200) +
+               "): a truncated or partly overwritten file");
+    }
+  }
+
+  void CheckVersion() {
+    int64_t version = 0;
+    db_.Query("PRAGMA user_version;",
+              [&](sqlite3_stmt* stmt) { version = Int(stmt, 0); });
+    // COLMAP writes MAJOR * 1000000 + MINOR * 10000 + PATCH * 100 + DEV.
+    if (version / 1000000 > format_version_ / 1000000) {
+      db_.Fail("was written by COLMAP " + Str(version / 1000000) + "." +
+               Str(version / 10000 % 100) +
+               ", whose database format this program (format " +
+               Str(format_version_ / 1000000) + "." +
+               Str(format_version_ / 10000 % 100) + ") does not know");
+    }
+  }
+
+  // False for a database without tables.
+  bool CheckTables() {
+    db_.Query("SELECT name FROM sqlite_master WHERE type = 'table';",
+              [&](sqlite3_stmt* stmt) { tables_.insert(Text(stmt, 0)); });
+    if (tables_.empty()) {
+      return false;
+    }
+    std::vector<std::string> missing;
+    for (const char* table : kCoreTables) {
+      if (!tables_.count(table)) {
+        missing.push_back(table);
+      }
+    }
+    if (missing.size() == std::size(kCoreTables)) {
+      std::string names;
+      for (const auto& table : tables_) {
+        names += (names.empty() ? "" : ", ") + table;
+      }
+      db_.Fail("is not a COLMAP database (its tables: " + names + ")");
+    }
+    if (!missing.empty()) {
+      db_.Fail("lacks the table '" + missing.front() +
+               "' that every COLMAP database has (a damaged file)");
+    }
+    for (const auto& [table, columns] : RequiredColumns()) {
+      if (!tables_.count(table)) {
+        continue;
+      }
+      std::set<std::string> present;
+      db_.Query("PRAGMA table_info(" + table + ");",
+                [&](sqlite3_stmt* stmt) { present.insert(Text(stmt, 1)); });
+      for (const auto& column : columns) {
+        if (!present.count(column)) {
+          db_.Fail("table '" + table + "' lacks the column '" + column + "'");
+        }
+      }
+    }
+    return true;
+  }
+
+  void CheckCameras() {
+    db_.Query(
+        "SELECT camera_id, model, width, height, params FROM cameras;",
+        [&](sqlite3_stmt* stmt) {
+          const int64_t camera_id = Int(stmt, 0);
+          const std::string row = "cameras row " + Str(camera_id) + ": ";
+          const int64_t model = Int(stmt, 1);
+          if (model < 0 || model > 1000000 ||
+              !ExistsCameraModelWithId(static_cast<CameraModelId>(model))) {
+            db_.Fail(row + "unknown camera model id " + Str(model));
+          }
+          const auto model_id = static_cast<CameraModelId>(model);
+          if (Int(stmt, 2) <= 0 || Int(stmt, 3) <= 0) {
+            db_.Fail(row + "image size " + Str(Int(stmt, 2)) + "x" +
+                     Str(Int(stmt, 3)) + " is not positive");
+          }
+          const size_t num_params = CameraModelNumParams(model_id);
+          const int64_t bytes = Bytes(stmt, 4);
+          if (bytes != static_cast<int64_t>(num_params * sizeof(double))) {
+            db_.Fail(row + CameraModelIdToName(model_id) + " has " +
+                     Str(num_params) + " parameters, but the params blob " +
+                     "holds " + Str(bytes) + " bytes, not " +
+                     Str(num_params * sizeof(double)));
+          }
+          std::vector<double> params(num_params);
+          if (num_params > 0) {
+            std::memcpy(params.data(), sqlite3_column_blob(stmt, 4),
+                        num_params * sizeof(double));
+          }
+          for (size_t i = 0; i < num_params; ++i) {
+            if (!std::isfinite(params[i])) {
+              db_.Fail(row + "parameter " + Str(i + 1) + " of " +
+                       CameraModelIdToName(model_id) + " is " +
+                       Str(params[i]));
+            }
+          }
+          cameras_.insert(camera_id);
+        });
+  }
+
+  void CheckImages() {
+    db_.Query("SELECT image_id, name, camera_id FROM images;",
+              [&](sqlite3_stmt* stmt) {
+                const int64_t image_id = Int(stmt, 0);
+                const std::string name = Text(stmt, 1);
+                if (!cameras_.count(Int(stmt, 2))) {
+                  db_.Fail("image " + Str(image_id) + " (" + name +
+                           ") refers to camera " + Str(Int(stmt, 2)) +
+                           ", which is not in the cameras table");
+                }
+                images_.emplace(image_id, name);
+              });
+  }
+
+  std::string ImageName(int64_t image_id) const {
+    return "image " + Str(image_id) + " (" + images_.at(image_id) + ")";
+  }
+
+  // `table` row of `image_id` or of its pair: a prefix of the messages.
+  std::string RowOfImage(const std::string& table, int64_t image_id) const {
+    if (!images_.count(image_id)) {
+      db_.Fail(table + " of image " + Str(image_id) +
+               ", which is not in the images table");
+    }
+    return table + " of " + ImageName(image_id) + ": ";
+  }
+
+  void CheckMatrix(const std::string& row, int64_t rows, int64_t cols,
+                   int64_t bytes, int64_t bytes_per_value) const {
+    if (rows < 0 || cols < 0) {
+      db_.Fail(row + "negative size " + Str(rows) + "x" + Str(cols));
+    }
+    if (rows * cols * bytes_per_value != bytes) {
+      db_.Fail(row + Str(rows) + "x" + Str(cols) + " values need " +
+               Str(rows * cols * bytes_per_value) + " bytes, the blob holds " +
+               Str(bytes));
+    }
+  }
+
+  void CheckFeatures() {
+    auto& num_keypoints = num_keypoints_;
+    db_.Query("SELECT image_id, rows, cols, data FROM keypoints;",
+              [&](sqlite3_stmt* stmt) {
+                const int64_t image_id = Int(stmt, 0);
+                const std::string row = RowOfImage("keypoints", image_id);
+                const int64_t rows = Int(stmt, 1), cols = Int(stmt, 2);
+                if (rows > 0 && cols != 2 && cols != 4 && cols != 6) {
+                  db_.Fail(row + Str(cols) +
+                           " columns (a keypoint has 2, 4 or 6 values)");
+                }
+                CheckMatrix(row, rows, cols, Bytes(stmt, 3), sizeof(float));
+                num_keypoints[image_id] = rows;
+              });
+    std::set<std::string> columns;
+    db_.Query("PRAGMA table_info(descriptors);",
+              [&](sqlite3_stmt* stmt) { columns.insert(Text(stmt, 1)); });
+    const std::string type = columns.count("type") ? "type" : "0";
+    db_.Query(
+        "SELECT image_id, rows, cols, data, " + type + " FROM descriptors;",
+        [&](sqlite3_stmt* stmt) {
+          const int64_t image_id = Int(stmt, 0);
+          const std::string row = RowOfImage("descriptors", image_id);
+          const int64_t rows = Int(stmt, 1), cols = Int(stmt, 2);
+          CheckMatrix(row, rows, cols, Bytes(stmt, 3), 1);
+          if (rows > 0 && Int(stmt, 4) == kSiftType && cols != 128) {
+            db_.Fail(row + "SIFT descriptors of " + Str(cols) +
+                     " values (they have 128)");
+          }
+          const auto keypoints = num_keypoints.find(image_id);
+          if (keypoints != num_keypoints.end() && keypoints->second != rows) {
+            db_.Fail(row + Str(rows) + " descriptors for " +
+                     Str(keypoints->second) + " keypoints");
+          }
+        });
+  }
+
+  void CheckPairs(const std::string& table, bool geometries) {
+    std::set<std::string> columns;
+    db_.Query("PRAGMA table_info(" + table + ");",
+              [&](sqlite3_stmt* stmt) { columns.insert(Text(stmt, 1)); });
+    // Blob columns of two-view geometries and their sizes when set.
+    std::vector<std::pair<std::string, int64_t>> blobs;
+    if (geometries) {
+      for (const auto& [column, size] :
+           std::vector<std::pair<std::string, int64_t>>{
+               {"F", 72}, {"E", 72}, {"H", 72}, {"qvec", 32}, {"tvec", 24}}) {
+        if (columns.count(column)) {
+          blobs.emplace_back(column, size);
+        }
+      }
+    }
+    std::string sql = "SELECT pair_id, rows, cols, data";
+    sql += geometries ? ", config" : ", 0";
+    for (const auto& blob : blobs) {
+      sql += ", " + blob.first;
+    }
+    db_.Query(sql + " FROM " + table + ";", [&](sqlite3_stmt* stmt) {
+      const int64_t pair_id = Int(stmt, 0);
+      if (pair_id < 0) {
+        db_.Fail(table + " row " + Str(pair_id) + ": negative pair id");
+      }
+      const auto [image_id1, image_id2] =
+          PairIdToImagePair(static_cast<image_pair_t>(pair_id));
+      for (const image_t image_id : {image_id1, image_id2}) {
+        if (!images_.count(image_id)) {
+          db_.Fail(table + " row " + Str(pair_id) + " (images " +
+                   Str(image_id1) + " and " + Str(image_id2) +
+                   "): image " + Str(image_id) +
+                   " is not in the images table");
+        }
+      }
+      const std::string row = table + " of " + ImageName(image_id1) +
+                              " and " + ImageName(image_id2) + ": ";
+      const int64_t rows = Int(stmt, 1), cols = Int(stmt, 2);
+      if (rows > 0 && cols != 2) {
+        db_.Fail(row + Str(cols) + " columns (a match has 2 indices)");
+      }
+      CheckMatrix(row, rows, cols, Bytes(stmt, 3), sizeof(uint32_t));
+      // Each match is a keypoint index in either image.
+      const char* data = static_cast<const char*>(sqlite3_column_blob(stmt, 3));
+      uint32_t max_index[2] = {0, 0};
+      for (int64_t i = 0; i < rows * cols; ++i) {
+        uint32_t index;  // the blob need not be aligned
+        std::memcpy(&index, data + i * sizeof(index), sizeof(index));
+        max_index[i % 2] = std::max(max_index[i % 2], index);
+      }
+      for (int k = 0; k < 2 && rows > 0; ++k) {
+        const image_t image_id = k == 0 ? image_id1 : image_id2;
+        const auto keypoints = num_keypoints_.find(image_id);
+        const int64_t num =
+            keypoints == num_keypoints_.end() ? 0 : keypoints->second;
+        if (max_index[k] >= num) {
+          db_.Fail(row + "a match refers to keypoint " + Str(max_index[k]) +
+                   " of " + ImageName(image_id) + ", which has " + Str(num) +
+                   " keypoints");
+        }
+      }
+      if (geometries && (Int(stmt, 4) < 0 || Int(stmt, 4) > kMaxConfig)) {
+        db_.Fail(row + "unknown configuration " + Str(Int(stmt, 4)));
+      }
+      for (size_t i = 0; i < blobs.size(); ++i) {
+        const int64_t bytes = Bytes(stmt, 5 + static_cast<int>(i));
+        if (bytes != 0 && bytes != blobs[i].second) {
+          db_.Fail(row + blobs[i].first + " holds " + Str(bytes) +
+                   " bytes, not " + Str(blobs[i].second));
+        }
+      }
+    });
+  }
+
+  void CheckRigsAndFrames() {
+    std::unordered_set<int64_t> rigs, frames;
+    auto check_sensor = [&](const std::string& row, int64_t sensor_id,
+                            int64_t sensor_type) {
+      if (sensor_type == kCameraSensor && !cameras_.count(sensor_id)) {
+        db_.Fail(row + "camera " + Str(sensor_id) +
+                 " is not in the cameras table");
+      }
+    };
+    if (tables_.count("rigs")) {
+      db_.Query("SELECT rig_id, ref_sensor_id, ref_sensor_type FROM rigs;",
+                [&](sqlite3_stmt* stmt) {
+                  check_sensor("rig " + Str(Int(stmt, 0)) + ": reference ",
+                               Int(stmt, 1), Int(stmt, 2));
+                  rigs.insert(Int(stmt, 0));
+                });
+    }
+    if (tables_.count("rig_sensors")) {
+      db_.Query("SELECT rig_id, sensor_id, sensor_type FROM rig_sensors;",
+                [&](sqlite3_stmt* stmt) {
+                  const std::string row =
+                      "rig_sensors of rig " + Str(Int(stmt, 0)) + ": ";
+                  if (!rigs.count(Int(stmt, 0))) {
+                    db_.Fail(row + "the rig is not in the rigs table");
+                  }
+                  check_sensor(row, Int(stmt, 1), Int(stmt, 2));
+                });
+    }
+    if (tables_.count("frames")) {
+      db_.Query("SELECT frame_id, rig_id FROM frames;", [&](sqlite3_stmt* stmt) {
+        if (!rigs.count(Int(stmt, 1))) {
+          db_.Fail("frame " + Str(Int(stmt, 0)) + " refers to rig " +
+                   Str(Int(stmt, 1)) + ", which is not in the rigs table");
+        }
+        frames.insert(Int(stmt, 0));
+      });
+    }
+    if (tables_.count("frame_data")) {
+      db_.Query(
+          "SELECT frame_id, data_id, sensor_id, sensor_type FROM frame_data;",
+          [&](sqlite3_stmt* stmt) {
+            const std::string row = "frame_data of frame " +
+                                    Str(Int(stmt, 0)) + ": ";
+            if (!frames.count(Int(stmt, 0))) {
+              db_.Fail(row + "the frame is not in the frames table");
+            }
+            check_sensor(row, Int(stmt, 2), Int(stmt, 3));
+            if (Int(stmt, 3) == kCameraSensor && !images_.count(Int(stmt, 1))) {
+              db_.Fail(row + "image " + Str(Int(stmt, 1)) +
+                       " is not in the images table");
+            }
+          });
+    }
+  }
+
+  ReadOnlyDatabase db_;
+  const int format_version_;
+  std::set<std::string> tables_;
+  std::unordered_set<int64_t> cameras_;
+  std::unordered_map<int64_t, std::string> images_;
+  std::unordered_map<int64_t, int64_t> num_keypoints_;
+};
+
+}  // namespace
+
+std::string MissingDatabaseError(const std::string& command, int argc,
+                                 const char* const* argv) {
+  static const std::set<std::string> kCreating = {
+      "feature_extractor", "feature_importer", "database_creator",
+      "automatic_reconstructor", "gui"};
+  if (kCreating.count(command)) {
+    return "";
+  }
+  const std::string option = "--database_path";
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    std::string path;
+    if (arg == option && i + 1 < argc) {
+      path = argv[i + 1];
+    } else if (arg.rfind(option + "=", 0) == 0) {
+      path = arg.substr(option.size() + 1);
+    } else {
+      continue;
+    }
+    std::error_code error;
+    if (!std::filesystem::exists(path, error)) {
+      return "database " + path +
+             " does not exist (feature_extractor creates a database)";
+    }
+    if (std::filesystem::is_regular_file(path, error) &&
+        std::filesystem::file_size(path, error) == 0) {
+      return "database " + path +
+             " is empty (feature_extractor fills a database)";
+    }
+  }
+  return "";
+}
+
+std::string MissingPaths(int argc, const char* const* argv) {
+  std::string missing;
+  for (int i = 1; i < argc; ++i) {
+    std::string option = argv[i];
+    std::string value;
+    const size_t equals = option.find('=');
+    if (equals != std::string::npos) {
+      value = option.substr(equals + 1);
+      option = option.substr(0, equals);
+    } else if (i + 1 < argc) {
+      value = argv[i + 1];
+    }
+    const size_t suffix = option.rfind("_path");
+    std::error_code error;
+    if (option.rfind("--", 0) != 0 || suffix == std::string::npos ||
+        suffix + 5 != option.size() || value.empty() ||
+        std::filesystem::exists(value, error)) {
+      continue;
+    }
+    missing += (missing.empty() ? "paths that do not exist: " : ", ") +
+               option + " " + value;
+  }
+  return missing;
+}
+
+void CheckDatabaseFile(const std::filesystem::path& path,
+                       const int format_version) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error) ||
+      std::filesystem::file_size(path, error) == 0 || error) {
+    return;
+  }
+  DatabaseChecker(path, format_version).Run();
+}
+
+}  // namespace colmap

@@ -1,0 +1,42 @@
+// A check of a COLMAP database file before COLMAP opens it for writing.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace colmap {
+
+// Checks the existing COLMAP database at `path` for the damage that would
+// make COLMAP's readers abort, read past a blob or silently use garbage, and
+// throws std::runtime_error "database PATH: WHAT" (naming the table, the
+// row and what is wrong) on the first problem found. The file is opened
+// read only and is never changed. Checked: that SQLite can read every page
+// (quick_check); that it is a COLMAP database of a format this program
+// knows (`format_version`: its own PRAGMA user_version; a newer major
+// version is refused), with all the core tables and their columns; camera
+// models, sizes and parameters (count and finite values); that images,
+// keypoints, descriptors, matches, two-view geometries, rigs and frames
+// refer to rows that exist; that every blob has the size its rows and
+// columns declare, keypoints 2, 4 or 6 columns, SIFT descriptors 128, as
+// many descriptors as keypoints, matches (raw and verified) of keypoints
+// that exist, two-view configurations known. Tables of later schema
+// versions may be missing (an older database, which COLMAP migrates). The
+// cost is one read of the file. A file that does not exist or is empty (a
+// new database) passes.
+void CheckDatabaseFile(const std::filesystem::path& path, int format_version);
+
+// Empty, or why `colmap COMMAND ARGS` cannot run: its --database_path names
+// a file that does not exist or is empty, and the command only reads and
+// adds to a database (every command but feature_extractor,
+// feature_importer, database_creator, automatic_reconstructor and gui,
+// which create one). COLMAP would create an empty database there and then
+// fail, leaving the new file behind.
+std::string MissingDatabaseError(const std::string& command, int argc,
+                                 const char* const* argv);
+
+// Empty, or "paths that do not exist: --OPTION PATH, ..." for the options
+// of ARGS named *_path whose value is not in the file system (said after a
+// command failed, whichever path made it fail).
+std::string MissingPaths(int argc, const char* const* argv);
+
+}  // namespace colmap
