@@ -5,6 +5,7 @@
 find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs)
 set(SPHERA_COLMAP_CONTROLLER_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/controllers/image_errors.cc
+  ${CMAKE_CURRENT_LIST_DIR}/image/image_file_structure.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/mapper_report.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/model_evaluation.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_bundle_adjustment.cc

@@ -21,6 +21,8 @@ readonly PACKAGES=(
   libopengv-dev libopencv-dev
   # tests, benchmarks and plots
   python3 python3-numpy python3-scipy python3-matplotlib sqlite3
+  # fuzz targets: libFuzzer, AddressSanitizer, UBSan (scripts/fuzz.sh)
+  clang libclang-rt-14-dev
 )
 
 missing=()

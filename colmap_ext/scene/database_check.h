@@ -1,6 +1,7 @@
 // A check of a COLMAP database file before COLMAP opens it for writing.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -33,6 +34,17 @@ void CheckDatabaseFile(const std::filesystem::path& path, int format_version);
 // fail, leaving the new file behind.
 std::string MissingDatabaseError(const std::string& command, int argc,
                                  const char* const* argv);
+
+// Removes from the database at `path` (if it exists), in one transaction,
+// the cameras that no image uses, together with the rigs of which such a
+// camera is the only sensor and that no frame uses: what a feature
+// extraction killed midway leaves (it writes an image's camera and rig
+// before the image). `keep_camera_id` (--ImageReader.existing_camera_id,
+// a camera made beforehand for the images to come) is kept. Returns the
+// number of cameras removed; throws like CheckDatabaseFile when the file
+// cannot be changed.
+int RemoveUnusedCameras(const std::filesystem::path& path,
+                        int64_t keep_camera_id);
 
 // Empty, or "paths that do not exist: --OPTION PATH, ..." for the options
 // of ARGS named *_path whose value is not in the file system (said after a

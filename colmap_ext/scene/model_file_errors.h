@@ -1,4 +1,5 @@
-// Errors of the model readers that name the file they come from.
+// Model files: errors of the readers that name the file they come from, and
+// writes that replace a model only once the new one is complete.
 #pragma once
 
 #include "colmap/scene/reconstruction.h"
@@ -7,8 +8,10 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace colmap {
@@ -23,6 +26,33 @@ void ReadModelFile(const std::filesystem::path& path, Read&& read) {
     read();
   } catch (const std::exception& error) {
     throw std::runtime_error(path.string() + ": " + error.what());
+  }
+}
+
+// Writes the files of a model into the folder `path`: each first under its
+// name + ".tmp", and only when all are written are they renamed to their
+// names, so that a run killed while writing (or a write that fails) leaves
+// the model that was there. files: (file name, write(file path)).
+inline void WriteModelFiles(
+    const std::filesystem::path& path,
+    const std::vector<std::pair<std::string,
+                                std::function<void(const std::filesystem::path&)>>>&
+        files) {
+  std::vector<std::filesystem::path> written;
+  try {
+    for (const auto& [name, write] : files) {
+      written.push_back(path / (name + ".tmp"));
+      write(written.back());
+    }
+  } catch (...) {
+    std::error_code ignored;
+    for (const auto& tmp : written) {
+      std::filesystem::remove(tmp, ignored);
+    }
+    throw;
+  }
+  for (size_t i = 0; i < files.size(); ++i) {
+    std::filesystem::rename(written[i], path / files[i].first);
   }
 }
 

@@ -1,0 +1,171 @@
+#!/usr/bin/env bash
+# Fuzz targets of SPHERA's input checks, built with clang's libFuzzer under
+# AddressSanitizer and UndefinedBehaviorSanitizer (Debian: clang,
+# libclang-rt-14-dev; scripts/setup.sh installs them).
+#
+#   scripts/fuzz.sh                     short deterministic run: 20000
+#                                       inputs per target, seed 1 (CI)
+#   scripts/fuzz.sh --runs N            N inputs per target
+#   scripts/fuzz.sh --minutes M         M minutes per target (a long run;
+#                                       the targets run side by side)
+#   scripts/fuzz.sh ... TARGET...       only these targets
+#
+# Targets (tests/fuzz/):
+#   fuzz_database_check  the check of a COLMAP database file before COLMAP
+#                        opens it (colmap_ext/scene/database_check.cc)
+#   fuzz_image_bytes     the JPEG/PNG structure walk of feature extraction
+#                        (colmap_ext/image/image_file_structure.cc)
+#
+# Each target starts from seeds made here from a rendered scene (a small
+# database of two images, a JPEG and a PNG) and from every file in
+# tests/fuzz/regressions/TARGET/ (inputs that once failed: each must pass).
+# Work goes to build/fuzz/ (SPHERA_BUILD_DIR); an input that makes a target
+# fail is kept as build/fuzz/crashes/TARGET/crash-*; copy it into
+# tests/fuzz/regressions/TARGET/ once fixed. Needs the built colmap and
+# sphera_render (scripts/build.sh). Exit code: 0 when no target failed.
+set -euo pipefail
+
+readonly REPO_ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build}"
+readonly WORK="${BUILD_DIR}/fuzz"
+readonly COLMAP="${BUILD_DIR}/bin/colmap"
+readonly RENDER="${BUILD_DIR}/synthetic/sphera_render"
+readonly ALL_TARGETS=(fuzz_database_check fuzz_image_bytes)
+
+runs=20000
+minutes=0
+targets=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --runs) runs="$2"; shift 2 ;;
+    --minutes) minutes="$2"; shift 2 ;;
+    -h|--help) sed -n '2,28p' "$0"; exit 0 ;;
+    fuzz_*) targets+=("$1"); shift ;;
+    *) echo "fuzz.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
+  esac
+done
+[ ${#targets[@]} -gt 0 ] || targets=("${ALL_TARGETS[@]}")
+
+for tool in clang++ "${COLMAP}" "${RENDER}"; do
+  if ! command -v "${tool}" >/dev/null 2>&1; then
+    echo "fuzz.sh: ${tool} not found (scripts/setup.sh installs clang," \
+         "scripts/build.sh builds the programs)" >&2
+    exit 1
+  fi
+done
+
+mkdir -p "${WORK}"
+log() { echo "[fuzz] $*"; }
+
+# -- build ------------------------------------------------------------------
+readonly FLAGS=(-std=c++17 -O1 -g -fno-omit-frame-pointer
+                -fsanitize=fuzzer,address,undefined
+                -fno-sanitize-recover=undefined
+                -I "${REPO_ROOT}" -I "${BUILD_DIR}/colmap-src/src"
+                -I /usr/include/eigen3)
+build_target() {
+  local target="$1" sources=()
+  case "${target}" in
+    fuzz_database_check)
+      sources=("${REPO_ROOT}/colmap_ext/scene/database_check.cc" -lsqlite3) ;;
+    fuzz_image_bytes)
+      sources=("${REPO_ROOT}/colmap_ext/image/image_file_structure.cc") ;;
+    *) echo "fuzz.sh: unknown target ${target}" >&2; exit 2 ;;
+  esac
+  local binary="${WORK}/${target}"
+  local inputs=("${REPO_ROOT}/tests/fuzz/${target}.cc" "${sources[@]}")
+  # Rebuilt when a source is newer than the binary.
+  local newest
+  newest="$(ls -t "${REPO_ROOT}/tests/fuzz/${target}.cc" \
+            "${REPO_ROOT}"/colmap_ext/scene/database_check.* \
+            "${REPO_ROOT}"/colmap_ext/image/image_file_structure.* \
+            "${binary}" 2>/dev/null | head -1 || true)"
+  if [ ! -x "${binary}" ] || [ "${newest}" != "${binary}" ]; then
+    log "building ${target}"
+    clang++ "${FLAGS[@]}" "${inputs[@]}" -o "${binary}.tmp"
+    mv "${binary}.tmp" "${binary}"
+  fi
+}
+
+# -- seeds ------------------------------------------------------------------
+make_seeds() {
+  local seeds="${WORK}/seeds"
+  [ -f "${seeds}/done" ] && return
+  rm -rf "${seeds}" "${WORK}/scene" "${WORK}/scene_png"
+  mkdir -p "${seeds}/fuzz_database_check" "${seeds}/fuzz_image_bytes"
+  "${RENDER}" --output "${WORK}/scene" --layout ring --num_cameras 2 \
+    --width 96 --height 72 --supersample 1 >/dev/null
+  "${RENDER}" --output "${WORK}/scene_png" --layout ring --num_cameras 2 \
+    --width 48 --height 36 --supersample 1 --format png >/dev/null
+  cp "${WORK}/scene/images/cam000.jpg" "${seeds}/fuzz_image_bytes/seed.jpg"
+  cp "${WORK}/scene_png/images/cam000.png" "${seeds}/fuzz_image_bytes/seed.png"
+  local db="${WORK}/seed.db"
+  rm -f "${db}"
+  "${COLMAP}" feature_extractor --database_path "${db}" \
+    --image_path "${WORK}/scene/images" --FeatureExtraction.use_gpu 0 \
+    --SiftExtraction.max_num_features 24 >/dev/null 2>&1
+  "${COLMAP}" exhaustive_matcher --database_path "${db}" \
+    --FeatureMatching.use_gpu 0 >/dev/null 2>&1
+  # One file, no write-ahead log beside it.
+  python3 - "${db}" "${seeds}/fuzz_database_check/seed.db" <<'EOF'
+import sqlite3, sys
+source = sqlite3.connect(sys.argv[1])
+target = sqlite3.connect(sys.argv[2])
+source.backup(target)
+target.execute("PRAGMA journal_mode=DELETE")
+target.execute("VACUUM")
+target.close()
+source.close()
+EOF
+  touch "${seeds}/done"
+}
+
+# -- run --------------------------------------------------------------------
+make_seeds
+for target in "${targets[@]}"; do
+  build_target "${target}"
+done
+
+status=0
+pids=()
+for target in "${targets[@]}"; do
+  corpus="${WORK}/corpus/${target}"
+  crashes="${WORK}/crashes/${target}"
+  regressions="${REPO_ROOT}/tests/fuzz/regressions/${target}"
+  mkdir -p "${corpus}" "${crashes}"
+  cp -n "${WORK}/seeds/${target}"/* "${corpus}/"
+  if [ -d "${regressions}" ] && [ -n "$(ls -A "${regressions}")" ]; then
+    log "${target}: regression inputs"
+    "${WORK}/${target}" "${regressions}"/* >"${WORK}/${target}.regressions.log" 2>&1 \
+      || { log "${target}: a regression input fails"; status=1; }
+  fi
+  max_len=$(( $(stat -c %s "${WORK}/seeds/${target}"/* | sort -n | tail -1) + 1024 ))
+  limit=(-runs="${runs}")
+  [ "${minutes}" != 0 ] && limit=(-max_total_time=$(( minutes * 60 )))
+  log "${target}: ${limit[*]}, inputs up to ${max_len} bytes"
+  (
+    cd "${crashes}"
+    "${WORK}/${target}" -seed=1 -max_len="${max_len}" -timeout=20 \
+      -rss_limit_mb=4096 -print_final_stats=1 "${limit[@]}" "${corpus}" \
+      >"${WORK}/${target}.log" 2>&1
+  ) &
+  pids+=($!)
+  # A short run: one target after the other (deterministic); a long run:
+  # side by side.
+  [ "${minutes}" = 0 ] && { wait "${pids[-1]}" || status=1; pids=(); }
+done
+for pid in "${pids[@]}"; do
+  wait "${pid}" || status=1
+done
+
+for target in "${targets[@]}"; do
+  stats="$(grep -E "stat::number_of_executed_units|cov: " "${WORK}/${target}.log" \
+           | tail -2 | tr '\n' ' ')"
+  log "${target}: ${stats}"
+  if grep -qE "ERROR: (AddressSanitizer|libFuzzer|UndefinedBehaviorSanitizer)|runtime error:" \
+       "${WORK}/${target}.log"; then
+    log "${target}: FAILED, see ${WORK}/${target}.log and ${WORK}/crashes/${target}/"
+    status=1
+  fi
+done
+exit "${status}"
