@@ -15,9 +15,14 @@
 #                        opens it (colmap_ext/scene/database_check.cc)
 #   fuzz_image_bytes     the JPEG/PNG structure walk of feature extraction
 #                        (colmap_ext/image/image_file_structure.cc)
+#   fuzz_model_readers   COLMAP's text and binary model readers as patched
+#                        (the two reader sources instrumented, the rest of
+#                        COLMAP linked from the build, as build.ninja links
+#                        the colmap program)
 #
 # Each target starts from seeds made here from a rendered scene (a small
-# database of two images, a JPEG and a PNG) and from every file in
+# database of two images, a JPEG and a PNG; a small valid model in both
+# formats, each file of it a seed) and from every file in
 # tests/fuzz/regressions/TARGET/ (inputs that once failed: each must pass).
 # Work goes to build/fuzz/ (SPHERA_BUILD_DIR); an input that makes a target
 # fail is kept as build/fuzz/crashes/TARGET/crash-*; copy it into
@@ -30,7 +35,7 @@ readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build}"
 readonly WORK="${BUILD_DIR}/fuzz"
 readonly COLMAP="${BUILD_DIR}/bin/colmap"
 readonly RENDER="${BUILD_DIR}/synthetic/sphera_render"
-readonly ALL_TARGETS=(fuzz_database_check fuzz_image_bytes)
+readonly ALL_TARGETS=(fuzz_database_check fuzz_image_bytes fuzz_model_readers)
 
 runs=20000
 minutes=0
@@ -63,13 +68,29 @@ readonly FLAGS=(-std=c++17 -O1 -g -fno-omit-frame-pointer
                 -fno-sanitize-recover=undefined
                 -I "${REPO_ROOT}" -I "${BUILD_DIR}/colmap-src/src"
                 -I /usr/include/eigen3)
+# The flags and libraries of the colmap program as build.ninja has them.
+ninja_field() {  # ninja_field BUILD_LINE_PATTERN FIELD
+  awk -v pattern="$1" -v field="$2" '
+    index($0, pattern) == 1 { found = 1 }
+    found && $1 == field { sub(/^ *[A-Z_]+ = /, ""); print; exit }' \
+    "${BUILD_DIR}/build.ninja"
+}
 build_target() {
   local target="$1" sources=()
+  local scene="${BUILD_DIR}/colmap-src/src/colmap/scene"
   case "${target}" in
     fuzz_database_check)
       sources=("${REPO_ROOT}/colmap_ext/scene/database_check.cc" -lsqlite3) ;;
     fuzz_image_bytes)
       sources=("${REPO_ROOT}/colmap_ext/image/image_file_structure.cc") ;;
+    fuzz_model_readers)
+      local object="build colmap/src/colmap/scene/CMakeFiles/colmap_scene.dir/reconstruction_io_binary.cc.o:"
+      local program="build colmap/src/colmap/exe/colmap: "
+      # shellcheck disable=SC2207
+      sources=($(ninja_field "${object}" DEFINES) $(ninja_field "${object}" INCLUDES)
+               "${scene}/reconstruction_io_binary.cc"
+               "${scene}/reconstruction_io_text.cc"
+               $(ninja_field "${program}" LINK_LIBRARIES) -fopenmp) ;;
     *) echo "fuzz.sh: unknown target ${target}" >&2; exit 2 ;;
   esac
   local binary="${WORK}/${target}"
@@ -77,12 +98,13 @@ build_target() {
   # Rebuilt when a source is newer than the binary.
   local newest
   newest="$(ls -t "${REPO_ROOT}/tests/fuzz/${target}.cc" \
-            "${REPO_ROOT}"/colmap_ext/scene/database_check.* \
+            "${REPO_ROOT}"/colmap_ext/scene/*.h "${REPO_ROOT}"/colmap_ext/scene/*.cc \
             "${REPO_ROOT}"/colmap_ext/image/image_file_structure.* \
-            "${binary}" 2>/dev/null | head -1 || true)"
+            "$(readlink -f "${COLMAP}")" "${binary}" 2>/dev/null | head -1 || true)"
   if [ ! -x "${binary}" ] || [ "${newest}" != "${binary}" ]; then
     log "building ${target}"
-    clang++ "${FLAGS[@]}" "${inputs[@]}" -o "${binary}.tmp"
+    # In the build folder: the libraries of build.ninja are relative to it.
+    (cd "${BUILD_DIR}" && clang++ "${FLAGS[@]}" "${inputs[@]}" -o "${binary}.tmp")
     mv "${binary}.tmp" "${binary}"
   fi
 }
@@ -90,9 +112,10 @@ build_target() {
 # -- seeds ------------------------------------------------------------------
 make_seeds() {
   local seeds="${WORK}/seeds"
-  [ -f "${seeds}/done" ] && return
+  [ -f "${seeds}/done" ] && [ -d "${WORK}/model/binary" ] && return
   rm -rf "${seeds}" "${WORK}/scene" "${WORK}/scene_png"
-  mkdir -p "${seeds}/fuzz_database_check" "${seeds}/fuzz_image_bytes"
+  mkdir -p "${seeds}/fuzz_database_check" "${seeds}/fuzz_image_bytes" \
+    "${seeds}/fuzz_model_readers"
   "${RENDER}" --output "${WORK}/scene" --layout ring --num_cameras 2 \
     --width 96 --height 72 --supersample 1 >/dev/null
   "${RENDER}" --output "${WORK}/scene_png" --layout ring --num_cameras 2 \
@@ -117,6 +140,28 @@ target.execute("VACUUM")
 target.close()
 source.close()
 EOF
+  # The model: bad_model_test's small valid model, in both formats; a seed
+  # is a file of it behind the byte that names it (bit 0: binary, then the
+  # file's index in rigs, cameras, frames, images, points3D).
+  local model="${WORK}/model"
+  rm -rf "${model}"
+  mkdir -p "${model}/binary" "${model}/text"
+  PYTHONPATH="${REPO_ROOT}/tests:${REPO_ROOT}/scripts" SPHERA_COLMAP="${COLMAP}" \
+    python3 -c "from bad_model_test import write_valid_text_model as w; w('${model}/first')"
+  "${COLMAP}" model_converter --input_path "${model}/first" \
+    --output_path "${model}/binary" --output_type BIN >/dev/null 2>&1
+  "${COLMAP}" model_converter --input_path "${model}/binary" \
+    --output_path "${model}/text" --output_type TXT >/dev/null 2>&1
+  python3 - "${model}" "${seeds}/fuzz_model_readers" <<'EOF'
+import sys
+model, seeds = sys.argv[1:]
+for binary, (folder, extension) in enumerate((("text", ".txt"), ("binary", ".bin"))):
+    for index, name in enumerate(("rigs", "cameras", "frames", "images", "points3D")):
+        with open(f"{model}/{folder}/{name}{extension}", "rb") as f:
+            data = f.read()
+        with open(f"{seeds}/{folder}_{name}", "wb") as f:
+            f.write(bytes([(index << 1) | binary]) + data)
+EOF
   touch "${seeds}/done"
 }
 
@@ -136,7 +181,8 @@ for target in "${targets[@]}"; do
   cp -n "${WORK}/seeds/${target}"/* "${corpus}/"
   if [ -d "${regressions}" ] && [ -n "$(ls -A "${regressions}")" ]; then
     log "${target}: regression inputs"
-    "${WORK}/${target}" "${regressions}"/* >"${WORK}/${target}.regressions.log" 2>&1 \
+    SPHERA_FUZZ_MODEL="${WORK}/model" \
+      "${WORK}/${target}" "${regressions}"/* >"${WORK}/${target}.regressions.log" 2>&1 \
       || { log "${target}: a regression input fails"; status=1; }
   fi
   max_len=$(( $(stat -c %s "${WORK}/seeds/${target}"/* | sort -n | tail -1) + 1024 ))
@@ -145,6 +191,7 @@ for target in "${targets[@]}"; do
   log "${target}: ${limit[*]}, inputs up to ${max_len} bytes"
   (
     cd "${crashes}"
+    export SPHERA_FUZZ_MODEL="${WORK}/model"
     "${WORK}/${target}" -seed=1 -max_len="${max_len}" -timeout=20 \
       -rss_limit_mb=4096 -print_final_stats=1 "${limit[@]}" "${corpus}" \
       >"${WORK}/${target}.log" 2>&1
