@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <filesystem>
 #include <functional>
+#include <istream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -26,6 +28,27 @@ void ReadModelFile(const std::filesystem::path& path, Read&& read) {
     read();
   } catch (const std::exception& error) {
     throw std::runtime_error(path.string() + ": " + error.what());
+  }
+}
+
+// Throws unless `stream` holds at least `count` more items of
+// `bytes_per_item` bytes: a count read from a damaged file must not make
+// the reader allocate for more than the file can hold. `what` names the
+// count in the message.
+inline void CheckCountFits(std::istream& stream, uint64_t count,
+                           uint64_t bytes_per_item, const std::string& what) {
+  const std::streampos here = stream.tellg();
+  stream.seekg(0, std::ios::end);
+  const std::streampos end = stream.tellg();
+  stream.seekg(here);
+  if (here < 0 || end < 0) {
+    return;  // not seekable: the reads fail at the end instead
+  }
+  const uint64_t left = static_cast<uint64_t>(end - here);
+  if (count > left / bytes_per_item) {
+    throw std::runtime_error(what + " is " + std::to_string(count) +
+                             ", more than the " + std::to_string(left) +
+                             " bytes left in the file can hold");
   }
 }
 

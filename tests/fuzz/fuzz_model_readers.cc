@@ -14,12 +14,35 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <vector>
 
 namespace {
 
 const char* const kFiles[] = {"rigs", "cameras", "frames", "images",
                               "points3D"};
+
+// The valid model's files, {text, binary} x kFiles, read once.
+const std::vector<std::string>& ValidFiles() {
+  static const std::vector<std::string> files = [] {
+    const char* env = std::getenv("SPHERA_FUZZ_MODEL");
+    const std::filesystem::path model(env ? env : "fuzz_model");
+    std::vector<std::string> contents;
+    for (const char* format : {"text", "binary"}) {
+      for (const char* name : kFiles) {
+        std::ifstream file(model / format /
+                               (std::string(name) +
+                                (format[0] == 't' ? ".txt" : ".bin")),
+                           std::ios::binary);
+        contents.emplace_back(std::istreambuf_iterator<char>(file),
+                              std::istreambuf_iterator<char>());
+      }
+    }
+    return contents;
+  }();
+  return files;
+}
 
 }  // namespace
 
@@ -27,22 +50,27 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) {
     return 0;
   }
-  static const std::filesystem::path model = [] {
-    const char* env = std::getenv("SPHERA_FUZZ_MODEL");
-    return std::filesystem::path(env ? env : "fuzz_model");
+  static const std::filesystem::path work = [] {
+    const std::filesystem::path path =
+        std::filesystem::temp_directory_path() /
+        ("sphera_fuzz_model_" + std::to_string(getpid()));
+    std::filesystem::create_directories(path);
+    return path;
   }();
-  static const std::filesystem::path work =
-      std::filesystem::temp_directory_path() /
-      ("sphera_fuzz_model_" + std::to_string(getpid()));
   const bool binary = data[0] & 1;
-  const std::string file =
-      std::string(kFiles[(data[0] >> 1) % 5]) + (binary ? ".bin" : ".txt");
-  std::filesystem::remove_all(work);
-  std::filesystem::copy(model / (binary ? "binary" : "text"), work);
-  {
-    std::ofstream out(work / file, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data + 1),
-              static_cast<std::streamsize>(size - 1));
+  const size_t damaged = (data[0] >> 1) % 5;
+  // Written with streams, which retry writes that a signal interrupts
+  // (libFuzzer's timer), unlike std::filesystem::copy.
+  for (size_t i = 0; i < 5; ++i) {
+    std::ofstream out(
+        work / (std::string(kFiles[i]) + (binary ? ".bin" : ".txt")),
+        std::ios::binary | std::ios::trunc);
+    if (i == damaged) {
+      out.write(reinterpret_cast<const char*>(data + 1),
+                static_cast<std::streamsize>(size - 1));
+    } else {
+      out << ValidFiles()[(binary ? 5 : 0) + i];
+    }
   }
   colmap::Reconstruction reconstruction;
   try {
