@@ -15,6 +15,9 @@
 #                        opens it (colmap_ext/scene/database_check.cc)
 #   fuzz_image_bytes     the JPEG/PNG structure walk of feature extraction
 #                        (colmap_ext/image/image_file_structure.cc)
+#   fuzz_camera_params   the check of --ImageReader.camera_model/_params
+#                        (colmap_ext/controllers/image_errors.cc and
+#                        colmap_ext/scene/camera_params_error.cc)
 #   fuzz_model_readers   COLMAP's text and binary model readers as patched
 #                        (the two reader sources instrumented, the rest of
 #                        COLMAP linked from the build, as build.ninja links
@@ -35,7 +38,8 @@ readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build}"
 readonly WORK="${BUILD_DIR}/fuzz"
 readonly COLMAP="${BUILD_DIR}/bin/colmap"
 readonly RENDER="${BUILD_DIR}/synthetic/sphera_render"
-readonly ALL_TARGETS=(fuzz_database_check fuzz_image_bytes fuzz_model_readers)
+readonly ALL_TARGETS=(fuzz_database_check fuzz_image_bytes fuzz_camera_params
+                      fuzz_model_readers)
 # COLMAP's log lines of every rejected input would cost most of the time.
 export GLOG_minloglevel=3
 
@@ -85,14 +89,20 @@ build_target() {
       sources=("${REPO_ROOT}/colmap_ext/scene/database_check.cc" -lsqlite3) ;;
     fuzz_image_bytes)
       sources=("${REPO_ROOT}/colmap_ext/image/image_file_structure.cc") ;;
-    fuzz_model_readers)
+    fuzz_camera_params|fuzz_model_readers)
+      # The sources under test instrumented, the rest of COLMAP linked from
+      # the build with the flags of one of its objects.
       local object="build colmap/src/colmap/scene/CMakeFiles/colmap_scene.dir/reconstruction_io_binary.cc.o:"
       local program="build colmap/src/colmap/exe/colmap: "
+      local own=("${scene}/reconstruction_io_binary.cc"
+                 "${scene}/reconstruction_io_text.cc")
+      [ "${target}" = fuzz_camera_params ] && own=(
+          "${REPO_ROOT}/colmap_ext/controllers/image_errors.cc"
+          "${REPO_ROOT}/colmap_ext/scene/camera_params_error.cc"
+          "${REPO_ROOT}/colmap_ext/image/image_file_structure.cc")
       # shellcheck disable=SC2207
       sources=($(ninja_field "${object}" DEFINES) $(ninja_field "${object}" INCLUDES)
-               "${scene}/reconstruction_io_binary.cc"
-               "${scene}/reconstruction_io_text.cc"
-               $(ninja_field "${program}" LINK_LIBRARIES) -fopenmp) ;;
+               "${own[@]}" $(ninja_field "${program}" LINK_LIBRARIES) -fopenmp) ;;
     *) echo "fuzz.sh: unknown target ${target}" >&2; exit 2 ;;
   esac
   local binary="${WORK}/${target}"
@@ -114,10 +124,18 @@ build_target() {
 # -- seeds ------------------------------------------------------------------
 make_seeds() {
   local seeds="${WORK}/seeds"
-  [ -f "${seeds}/done" ] && [ -d "${WORK}/model/binary" ] && return
+  [ -f "${seeds}/done" ] && [ -d "${seeds}/fuzz_camera_params" ] && return
   rm -rf "${seeds}" "${WORK}/scene" "${WORK}/scene_png"
   mkdir -p "${seeds}/fuzz_database_check" "${seeds}/fuzz_image_bytes" \
-    "${seeds}/fuzz_model_readers"
+    "${seeds}/fuzz_model_readers" "${seeds}/fuzz_camera_params"
+  local k=0
+  for line in "PINHOLE\n500,510,320,240" "EQUIRECTANGULAR\n2048,1024" \
+      "EUCM\n300,300,512,512,0.6,1.1" \
+      "UNIFIED_OMNI\n280,280,512,512,1.05,-0.02,0.003,0,0" \
+      "DOUBLE_SPHERE\n300,300,512,512,-0.2,0.6" "OPENCV_FISHEYE\n300,300,512,512,0,0,0,0"; do
+    printf "%b" "${line}" > "${seeds}/fuzz_camera_params/seed${k}"
+    k=$((k + 1))
+  done
   "${RENDER}" --output "${WORK}/scene" --layout ring --num_cameras 2 \
     --width 96 --height 72 --supersample 1 >/dev/null
   "${RENDER}" --output "${WORK}/scene_png" --layout ring --num_cameras 2 \
