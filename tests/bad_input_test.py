@@ -240,7 +240,7 @@ DAMAGED_DATABASES = [
     ("frame of a missing rig", sql_damage("UPDATE frames SET rig_id = 9")),
 ]
 DATABASE_COMMANDS = ("exhaustive_matcher", "sequential_matcher", "mapper",
-                     "point_triangulator", "feature_extractor")
+                     "point_triangulator", "feature_extractor", "global_mapper")
 
 
 class BadDatabaseTest(BadInputCase):
