@@ -266,6 +266,13 @@ class StepError(Exception):
     """A pipeline step failed; the message goes to the status column."""
 
 
+def record_failure(row, error):
+    """The status of a run that stopped on `error`: a failed step's message,
+    or the type and message of anything else."""
+    row["status"] = (str(error) if isinstance(error, StepError)
+                     else "%s: %s" % (type(error).__name__, error))
+
+
 def run_step(name, command, log_dir, timeout):
     """Runs `command`, logging to log_dir/name.log; returns (seconds, output).
     Raises StepError on a non-zero exit or timeout."""
@@ -780,10 +787,8 @@ class Benchmark:
                                      mapper_options, seed,
                                      self.extracted_path(dataset, system))
             self.score(run_dir, model, gt, depth, row)
-        except StepError as error:
-            row["status"] = str(error)
         except Exception as error:  # keep going with the other data sets
-            row["status"] = "%s: %s" % (type(error).__name__, error)
+            record_failure(row, error)
         return row
 
     def score(self, run_dir, model, gt, depth, row):
@@ -831,10 +836,8 @@ class Benchmark:
             model = self.map(self.colmap, run_dir, base["database"], image_path,
                              row, options, seed)
             self.score(run_dir, model, gt, depth, row)
-        except StepError as error:
-            row["status"] = str(error)
         except Exception as error:  # keep going with the other data sets
-            row["status"] = "%s: %s" % (type(error).__name__, error)
+            record_failure(row, error)
         return row
 
     def run_dataset(self, dataset):

@@ -475,6 +475,14 @@ class DatabaseChecker {
   std::unordered_map<int64_t, int64_t> num_keypoints_;
 };
 
+// False for a file that does not exist or is empty: a database COLMAP is
+// about to create.
+bool HoldsDatabase(const std::filesystem::path& path) {
+  std::error_code error;
+  return std::filesystem::exists(path, error) &&
+         std::filesystem::file_size(path, error) > 0 && !error;
+}
+
 }  // namespace
 
 std::string MissingDatabaseError(const std::string& command, int argc,
@@ -512,9 +520,7 @@ std::string MissingDatabaseError(const std::string& command, int argc,
 
 int RemoveUnusedCameras(const std::filesystem::path& path,
                         const int64_t keep_camera_id) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error) ||
-      std::filesystem::file_size(path, error) == 0 || error) {
+  if (!HoldsDatabase(path)) {
     return 0;
   }
   sqlite3* db = nullptr;
@@ -598,9 +604,7 @@ std::string MissingPaths(int argc, const char* const* argv) {
 
 void CheckDatabaseFile(const std::filesystem::path& path,
                        const int format_version) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error) ||
-      std::filesystem::file_size(path, error) == 0 || error) {
+  if (!HoldsDatabase(path)) {
     return;
   }
   DatabaseChecker(path, format_version).Run();
