@@ -22,6 +22,9 @@
 #                        (the two reader sources instrumented, the rest of
 #                        COLMAP linked from the build, as build.ninja links
 #                        the colmap program)
+#   fuzz_rig_config      rig_configurator's JSON reader as patched
+#                        (colmap/scene/rig.cc instrumented, the rest linked
+#                        as for fuzz_model_readers)
 #
 # Each target starts from seeds made here from a rendered scene (a small
 # database of two images, a JPEG and a PNG; a small valid model in both
@@ -39,7 +42,7 @@ readonly WORK="${BUILD_DIR}/fuzz"
 readonly COLMAP="${BUILD_DIR}/bin/colmap"
 readonly RENDER="${BUILD_DIR}/synthetic/sphera_render"
 readonly ALL_TARGETS=(fuzz_database_check fuzz_image_bytes fuzz_camera_params
-                      fuzz_model_readers)
+                      fuzz_model_readers fuzz_rig_config)
 # COLMAP's log lines of every rejected input would cost most of the time.
 export GLOG_minloglevel=3
 
@@ -89,13 +92,14 @@ build_target() {
       sources=("${REPO_ROOT}/colmap_ext/scene/database_check.cc" -lsqlite3) ;;
     fuzz_image_bytes)
       sources=("${REPO_ROOT}/colmap_ext/image/image_file_structure.cc") ;;
-    fuzz_camera_params|fuzz_model_readers)
+    fuzz_camera_params|fuzz_model_readers|fuzz_rig_config)
       # The sources under test instrumented, the rest of COLMAP linked from
       # the build with the flags of one of its objects.
       local object="build colmap/src/colmap/scene/CMakeFiles/colmap_scene.dir/reconstruction_io_binary.cc.o:"
       local program="build colmap/src/colmap/exe/colmap: "
       local own=("${scene}/reconstruction_io_binary.cc"
                  "${scene}/reconstruction_io_text.cc")
+      [ "${target}" = fuzz_rig_config ] && own=("${scene}/rig.cc")
       [ "${target}" = fuzz_camera_params ] && own=(
           "${REPO_ROOT}/colmap_ext/controllers/image_errors.cc"
           "${REPO_ROOT}/colmap_ext/scene/camera_params_error.cc"
@@ -124,10 +128,11 @@ build_target() {
 # -- seeds ------------------------------------------------------------------
 make_seeds() {
   local seeds="${WORK}/seeds"
-  [ -f "${seeds}/done" ] && [ -d "${seeds}/fuzz_camera_params" ] && return
-  rm -rf "${seeds}" "${WORK}/scene" "${WORK}/scene_png"
+  [ -f "${seeds}/done" ] && [ -d "${seeds}/fuzz_rig_config" ] && return
+  rm -rf "${seeds}" "${WORK}/scene" "${WORK}/scene_png" "${WORK}"/rig_*
   mkdir -p "${seeds}/fuzz_database_check" "${seeds}/fuzz_image_bytes" \
-    "${seeds}/fuzz_model_readers" "${seeds}/fuzz_camera_params"
+    "${seeds}/fuzz_model_readers" "${seeds}/fuzz_camera_params" \
+    "${seeds}/fuzz_rig_config"
   local k=0
   for line in "PINHOLE\n500,510,320,240" "EQUIRECTANGULAR\n2048,1024" \
       "EUCM\n300,300,512,512,0.6,1.1" \
@@ -140,6 +145,15 @@ make_seeds() {
     --width 96 --height 72 --supersample 1 >/dev/null
   "${RENDER}" --output "${WORK}/scene_png" --layout ring --num_cameras 2 \
     --width 48 --height 36 --supersample 1 --format png >/dev/null
+  # Rig configs: the renderer's true rigs (model, params, poses) and one
+  # with prefixes and a reference only.
+  for preset in dual_fisheye ring8; do
+    "${RENDER}" --output "${WORK}/rig_${preset}" --rig_preset "${preset}" \
+      --frames 1 --lens_size 32 --supersample 1 >/dev/null
+    cp "${WORK}/rig_${preset}/rig_config.json" "${seeds}/fuzz_rig_config/${preset}.json"
+  done
+  printf '[{"cameras": [{"image_prefix": "a/", "ref_sensor": true}, %s]}]\n' \
+    '{"image_prefix": "b/", "image_suffix": "_2.jpg"}' > "${seeds}/fuzz_rig_config/plain.json"
   cp "${WORK}/scene/images/cam000.jpg" "${seeds}/fuzz_image_bytes/seed.jpg"
   cp "${WORK}/scene_png/images/cam000.png" "${seeds}/fuzz_image_bytes/seed.png"
   local db="${WORK}/seed.db"

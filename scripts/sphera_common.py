@@ -247,15 +247,16 @@ def similarity_of_centres(est_centres, gt_centres):
     return scale, rotation, gt_mean - scale * rotation @ est_mean
 
 
-def pose_errors(gt_path, model_path):
-    """Aligns the text model at MODEL_PATH to the one at GT_PATH by the
-    least-squares similarity of the camera centres (Umeyama 1991) and returns
-    {image name: (rotation error in degrees, position error)} for the images
-    of both: ||log(R_gt R_est^T)|| and the distance of the centres."""
+def aligned_pose_errors(gt, est):
+    """{name: (rotation error in degrees, position error)} of the poses
+    {name: (R cam_from_world, position)} of EST against GT, for the names of
+    both, after the least-squares similarity of the positions (Umeyama
+    1991): ||log(R_gt R_est^T)|| and the distance of the aligned positions.
+    Empty with fewer than 3 common names."""
     import numpy as np
-    gt = text_model_poses(gt_path)
-    est = text_model_poses(model_path)
     names = sorted(set(gt) & set(est))
+    if len(names) < 3:
+        return {}
     scale, gt_from_est, translation = similarity_of_centres(
         np.array([est[n][1] for n in names]),
         np.array([gt[n][1] for n in names]))
@@ -265,8 +266,84 @@ def pose_errors(gt_path, model_path):
         # est cam_from_world composed with est_from_gt maps gt world to cam.
         relative = gt[name][0] @ (est[name][0] @ gt_from_est.T).T
         angle = np.arccos(np.clip((np.trace(relative) - 1) / 2, -1, 1))
-        errors[name] = (np.degrees(angle),
+        errors[name] = (float(np.degrees(angle)),
                         float(np.linalg.norm(centre - gt[name][1])))
+    return errors
+
+
+def pose_errors(gt_path, model_path):
+    """aligned_pose_errors of the images of the text models at GT_PATH and
+    MODEL_PATH (camera centres and orientations)."""
+    return aligned_pose_errors(text_model_poses(gt_path),
+                               text_model_poses(model_path))
+
+
+def read_text_rigs(path):
+    """{rig_id: {camera_id: (R sensor_from_rig, t) or None}} of
+    PATH/rigs.txt (COLMAP 4 text), the reference sensor with the identity;
+    sensors that are not cameras are left out."""
+    import numpy as np
+    rigs = {}
+    for fields in read_text_rows(os.path.join(path, "rigs.txt")):
+        sensors = {}
+        if int(fields[1]) > 0:
+            if fields[2] == "CAMERA":
+                sensors[int(fields[3])] = (np.eye(3), np.zeros(3))
+            rest = fields[4:]
+            while rest:
+                has_pose = rest[2] == "1"
+                pose = None
+                if has_pose:
+                    q = [float(v) for v in rest[3:7]]
+                    pose = (rotation_from_quaternion(*q),
+                            np.array([float(v) for v in rest[7:10]]))
+                if rest[0] == "CAMERA":
+                    sensors[int(rest[1])] = pose
+                rest = rest[10:] if has_pose else rest[3:]
+        rigs[int(fields[0])] = sensors
+    return rigs
+
+
+def sensors_by_folder(path):
+    """{image folder: (R sensor_from_rig, t)} of the text model at PATH: the
+    pose in its rig of every camera, named by the folder of its images (a
+    rig's lens images are FOLDER/NAME)."""
+    camera_folder = {}
+    for fields, _ in read_text_images(path).values():
+        camera_folder.setdefault(int(fields[8]), fields[9].split("/")[0])
+    sensors = {}
+    for rig in read_text_rigs(path).values():
+        for camera_id, pose in rig.items():
+            if camera_id in camera_folder and pose is not None:
+                sensors[camera_folder[camera_id]] = pose
+    return sensors
+
+
+def rig_errors(gt_path, model_path):
+    """{image folder: (rotation error in degrees, centre error)} of the
+    sensor_from_rig poses of the text model at MODEL_PATH against those of
+    GT_PATH: the angle of R_gt R_est^T and the distance of the lens centres
+    in the rig, the model's scaled to the ground truth by the similarity of
+    the image centres (as pose_errors)."""
+    import numpy as np
+    gt = text_model_poses(gt_path)
+    est = text_model_poses(model_path)
+    names = sorted(set(gt) & set(est))
+    scale, _, _ = similarity_of_centres(np.array([est[n][1] for n in names]),
+                                        np.array([gt[n][1] for n in names]))
+    gt_sensors = sensors_by_folder(gt_path)
+    errors = {}
+    for folder, (rotation, translation) in sensors_by_folder(
+            model_path).items():
+        if folder not in gt_sensors:
+            continue
+        gt_rotation, gt_translation = gt_sensors[folder]
+        relative = gt_rotation @ rotation.T
+        angle = np.arccos(np.clip((np.trace(relative) - 1) / 2, -1, 1))
+        centre = -rotation.T @ translation * scale
+        gt_centre = -gt_rotation.T @ gt_translation
+        errors[folder] = (float(np.degrees(angle)),
+                          float(np.linalg.norm(centre - gt_centre)))
     return errors
 
 

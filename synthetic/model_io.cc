@@ -188,11 +188,11 @@ std::string MakeLayout(const LayoutOptions& options, std::vector<VirtualCamera>*
   return "";
 }
 
-std::string ReadRigFile(const std::string& path, const std::string& default_extension,
-                        std::vector<VirtualCamera>* cameras) {
-  cameras->clear();
+std::string ForEachDataLine(
+    const std::string& path,
+    const std::function<std::string(const std::string& line, const std::string& where)>& parse) {
   std::ifstream file(path);
-  if (!file) return "cannot read rig file " + path;
+  if (!file) return "cannot read " + path;
   std::string line;
   int line_number = 0;
   while (std::getline(file, line)) {
@@ -200,7 +200,17 @@ std::string ReadRigFile(const std::string& path, const std::string& default_exte
     const size_t comment = line.find('#');
     if (comment != std::string::npos) line.resize(comment);
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    const std::string where = path + ":" + std::to_string(line_number) + ": ";
+    const std::string error = parse(line, path + ":" + std::to_string(line_number) + ": ");
+    if (!error.empty()) return error;
+  }
+  return "";
+}
+
+std::string ReadRigFile(const std::string& path, const std::string& default_extension,
+                        std::vector<VirtualCamera>* cameras) {
+  cameras->clear();
+  const std::string error = ForEachDataLine(path, [&](const std::string& line,
+                                                      const std::string& where) -> std::string {
     const size_t bar = line.find('|');
     if (bar == std::string::npos) {
       return where + "expected 'NAME MODEL WIDTH HEIGHT PARAMS... | QW QX QY QZ TX TY TZ'";
@@ -243,7 +253,9 @@ std::string ReadRigFile(const std::string& path, const std::string& default_exte
     const std::string error = cam.Check();
     if (!error.empty()) return where + error;
     cameras->push_back(cam);
-  }
+    return "";
+  });
+  if (!error.empty()) return error;
   if (cameras->empty()) return "rig file " + path + " has no cameras";
   return "";
 }
@@ -295,7 +307,8 @@ std::vector<GroundTruthPoint> SamplePoints(const Scene& scene,
       Eigen::Vector2d pixel;
       if (!ImageFromRay(camera.model_id, camera.params, ray_in_cam, &pixel)) continue;
       if (!(pixel.x() >= 0 && pixel.y() >= 0 && pixel.x() < camera.width &&
-            pixel.y() < camera.height)) {
+            pixel.y() < camera.height) ||
+          !camera.InImageCircle(static_cast<int>(pixel.x()), static_cast<int>(pixel.y()))) {
         continue;
       }
       Eigen::Vector3d back;
@@ -318,6 +331,23 @@ std::string WriteDataset(const std::string& output_dir, const Scene& scene,
   if (error.empty()) error = scene.Options().Check();
   if (!error.empty()) return error;
   if (options.num_points < 0) return "--points must be >= 0";
+  if (options.rig != nullptr) {
+    const RigGroundTruth& rig = *options.rig;
+    const size_t num_sensors = rig.sensor_names.size();
+    if (num_sensors == 0 || rig.sensor_from_rig_rotation.size() != num_sensors ||
+        rig.sensor_from_rig_translation.size() != num_sensors ||
+        rig.rig_from_world_rotation.size() != rig.rig_from_world_translation.size() ||
+        rig.image_sensor.size() != cameras.size() || rig.image_frame.size() != cameras.size()) {
+      return "inconsistent rig description";
+    }
+    for (size_t i = 0; i < cameras.size(); ++i) {
+      if (rig.image_sensor[i] < 0 || rig.image_sensor[i] >= static_cast<int>(num_sensors) ||
+          rig.image_frame[i] < 0 ||
+          rig.image_frame[i] >= static_cast<int>(rig.rig_from_world_rotation.size())) {
+        return "camera '" + cameras[i].name + "': sensor or frame out of range";
+      }
+    }
+  }
 
   fs::path dir(output_dir);
   if (dir.empty()) return "no output directory given";
@@ -346,6 +376,15 @@ std::string WriteDataset(const std::string& output_dir, const Scene& scene,
     fs::create_directories(tmp / sub, ec);
     if (ec) return fail("cannot create " + (tmp / sub).string() + ": " + ec.message());
   }
+  for (const VirtualCamera& camera : cameras) {
+    const fs::path folder = fs::path(camera.name).parent_path();
+    if (folder.empty()) continue;
+    for (const char* sub : {"images", "depth", "masks"}) {
+      if (std::string(sub) == "masks" && camera.image_circle.z() <= 0) continue;
+      fs::create_directories(tmp / sub / folder, ec);
+      if (ec) return fail("cannot create " + (tmp / sub / folder).string() + ": " + ec.message());
+    }
+  }
 
   // Render.
   for (size_t i = 0; i < cameras.size(); ++i) {
@@ -368,6 +407,19 @@ std::string WriteDataset(const std::string& output_dir, const Scene& scene,
       return fail("cannot write " + image_path.string() + ": " + e.what());
     }
     if (!ok) return fail("cannot write " + image_path.string());
+    if (camera.image_circle.z() > 0) {
+      cv::Mat mask(camera.height, camera.width, CV_8U);
+      for (int row = 0; row < camera.height; ++row) {
+        for (int col = 0; col < camera.width; ++col) {
+          mask.at<uint8_t>(row, col) = camera.InImageCircle(col, row) ? 255 : 0;
+        }
+      }
+      const fs::path mask_path = tmp / "masks" / (camera.name + ".png");
+      fs::create_directories(mask_path.parent_path(), ec);
+      if (ec || !cv::imwrite(mask_path.string(), mask)) {
+        return fail("cannot write " + mask_path.string());
+      }
+    }
     const fs::path depth_path = tmp / "depth" / (camera.name + ".depth.bin");
     if (!WriteDepthMap(depth_path.string(), rendered.depth)) {
       return fail("cannot write " + depth_path.string());
@@ -383,7 +435,8 @@ std::string WriteDataset(const std::string& output_dir, const Scene& scene,
     }
   }
 
-  // Cameras: identical intrinsics share one camera id.
+  // Cameras: identical intrinsics share one camera id; in a rig, every
+  // sensor is its own camera (id = sensor index + 1).
   std::map<std::string, int> camera_ids;
   std::vector<int> image_camera_id(cameras.size());
   std::ostringstream cameras_txt;
@@ -391,12 +444,16 @@ std::string WriteDataset(const std::string& output_dir, const Scene& scene,
               << "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n";
   for (size_t i = 0; i < cameras.size(); ++i) {
     const VirtualCamera& camera = cameras[i];
-    const std::string key = camera.model_name + " " + std::to_string(camera.width) + " " +
-                            std::to_string(camera.height) + " " + Join(camera.params);
+    const std::string intrinsics = camera.model_name + " " + std::to_string(camera.width) + " " +
+                                   std::to_string(camera.height) + " " + Join(camera.params);
+    const std::string key =
+        options.rig ? std::to_string(options.rig->image_sensor[i]) : intrinsics;
     auto it = camera_ids.find(key);
     if (it == camera_ids.end()) {
-      it = camera_ids.emplace(key, static_cast<int>(camera_ids.size()) + 1).first;
-      cameras_txt << it->second << " " << key << "\n";
+      const int id = options.rig ? options.rig->image_sensor[i] + 1
+                                 : static_cast<int>(camera_ids.size()) + 1;
+      it = camera_ids.emplace(key, id).first;
+      cameras_txt << it->second << " " << intrinsics << "\n";
     }
     image_camera_id[i] = it->second;
   }
@@ -455,17 +512,61 @@ std::string WriteDataset(const std::string& output_dir, const Scene& scene,
     points_txt << "\n";
   }
 
-  const std::vector<std::pair<fs::path, std::string>> texts = {
+  std::vector<std::pair<fs::path, std::string>> texts = {
       {tmp / "sparse_gt" / "cameras.txt", cameras_txt.str()},
       {tmp / "sparse_gt" / "images.txt", images_txt.str()},
       {tmp / "sparse_gt" / "points3D.txt", points_txt.str()},
       {tmp / "rig.txt", rig_txt.str()},
   };
+  if (options.rig != nullptr) {
+    const RigGroundTruth& rig = *options.rig;
+    // COLMAP 4 text: sensor type CAMERA, sensor id = camera id, data id =
+    // image id.
+    std::ostringstream rigs_txt, frames_txt;
+    rigs_txt << std::setprecision(17);
+    frames_txt << std::setprecision(17);
+    rigs_txt << "# Rig calib list with one line of data per calib:\n"
+             << "#   RIG_ID, NUM_SENSORS, REF_SENSOR_TYPE, REF_SENSOR_ID, SENSORS[] as "
+                "(SENSOR_TYPE, SENSOR_ID, HAS_POSE, [QW, QX, QY, QZ, TX, TY, TZ])\n"
+             << "1 " << rig.sensor_names.size() << " CAMERA 1";
+    for (size_t k = 1; k < rig.sensor_names.size(); ++k) {
+      const Eigen::Quaterniond& q = rig.sensor_from_rig_rotation[k];
+      const Eigen::Vector3d& t = rig.sensor_from_rig_translation[k];
+      rigs_txt << " CAMERA " << k + 1 << " 1 " << q.w() << " " << q.x() << " " << q.y() << " "
+               << q.z() << " " << t.x() << " " << t.y() << " " << t.z();
+    }
+    rigs_txt << "\n";
+    frames_txt << "# Frame list with one line of data per frame:\n"
+               << "#   FRAME_ID, RIG_ID, RIG_FROM_WORLD[QW, QX, QY, QZ, TX, TY, TZ], "
+                  "NUM_DATA_IDS, DATA_IDS[] as (SENSOR_TYPE, SENSOR_ID, DATA_ID)\n";
+    for (size_t f = 0; f < rig.rig_from_world_rotation.size(); ++f) {
+      std::vector<size_t> members;
+      for (size_t i = 0; i < cameras.size(); ++i) {
+        if (rig.image_frame[i] == static_cast<int>(f)) members.push_back(i);
+      }
+      if (members.empty()) continue;
+      const Eigen::Quaterniond& q = rig.rig_from_world_rotation[f];
+      const Eigen::Vector3d& t = rig.rig_from_world_translation[f];
+      frames_txt << f + 1 << " 1 " << q.w() << " " << q.x() << " " << q.y() << " " << q.z()
+                 << " " << t.x() << " " << t.y() << " " << t.z() << " " << members.size();
+      for (const size_t i : members) {
+        frames_txt << " CAMERA " << image_camera_id[i] << " " << i + 1;
+      }
+      frames_txt << "\n";
+    }
+    texts.emplace_back(tmp / "sparse_gt" / "rigs.txt", rigs_txt.str());
+    texts.emplace_back(tmp / "sparse_gt" / "frames.txt", frames_txt.str());
+  }
   for (const auto& [path, text] : texts) {
     std::ofstream file(path);
     file << text;
     file.close();
     if (!file) return fail("cannot write " + path.string());
+  }
+
+  if (options.extra) {
+    const std::string extra_error = options.extra(tmp.string(), log);
+    if (!extra_error.empty()) return fail(extra_error);
   }
 
   if (dir_exists) {

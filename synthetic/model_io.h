@@ -9,6 +9,8 @@
 //                                      POINTS2D[] as (X, Y, POINT3D_ID) (empty without points)
 //   DIR/sparse_gt/points3D.txt         POINT3D_ID X Y Z R G B ERROR TRACK[] (IMAGE_ID, POINT2D_IDX)
 //   DIR/rig.txt                        the cameras in rig-file format (reproducible input)
+//   DIR/masks/NAME.png                 for cameras with an image circle: 255 inside it
+//   DIR/sparse_gt/{rigs,frames}.txt    for a rig (DatasetOptions::rig), COLMAP 4 text
 // Poses are cam_from_world (COLMAP). Pixels: upper-left image corner is (0, 0).
 //
 // Rig file: one camera per line, '#' starts a comment:
@@ -17,11 +19,13 @@
 #define SPHERA_SYNTHETIC_MODEL_IO_H_
 
 #include <cstdint>
+#include <functional>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "synthetic/render.h"
 #include "synthetic/scene.h"
@@ -58,6 +62,13 @@ struct LayoutOptions {
 // Empty string on success, else a message.
 std::string MakeLayout(const LayoutOptions& options, std::vector<VirtualCamera>* cameras);
 
+// Calls `parse(line, where)` for every line of the text file `path` that
+// holds data ('#' starts a comment); `where` is "PATH:LINE: ". Returns the
+// first non-empty message of `parse`, "cannot read PATH", or "".
+std::string ForEachDataLine(
+    const std::string& path,
+    const std::function<std::string(const std::string& line, const std::string& where)>& parse);
+
 // Reads a rig file. Names without .jpg/.jpeg/.png get `default_extension`.
 // Empty string on success, else a message naming the line and camera.
 std::string ReadRigFile(const std::string& path, const std::string& default_extension,
@@ -79,15 +90,32 @@ struct GroundTruthPoint {
 };
 
 // Up to `num_points` random surface points seen unoccluded by at least two
-// cameras, with their exact projections.
+// cameras (inside their image circles), with their exact projections.
 std::vector<GroundTruthPoint> SamplePoints(const Scene& scene,
                                            const std::vector<VirtualCamera>& cameras,
                                            int num_points, uint64_t seed);
+
+// The rig of a dataset: sensors (index 0 is the reference), frames, and for
+// every camera of the dataset its sensor and frame.
+struct RigGroundTruth {
+  std::vector<std::string> sensor_names;
+  std::vector<Eigen::Quaterniond> sensor_from_rig_rotation;
+  std::vector<Eigen::Vector3d> sensor_from_rig_translation;
+  std::vector<Eigen::Quaterniond> rig_from_world_rotation;  // per frame
+  std::vector<Eigen::Vector3d> rig_from_world_translation;
+  std::vector<int> image_sensor;  // per camera
+  std::vector<int> image_frame;
+};
 
 struct DatasetOptions {
   RenderOptions render;
   int num_points = 0;
   uint64_t points_seed = 0;
+  // Set for a rig: one camera per sensor, rigs.txt and frames.txt.
+  const RigGroundTruth* rig = nullptr;
+  // Writes further outputs into the staging directory before it is renamed
+  // into place; returns an error message or "".
+  std::function<std::string(const std::string& staging_dir, std::ostream* log)> extra;
 };
 
 // Renders every camera and writes the dataset into `output_dir` atomically

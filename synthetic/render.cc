@@ -21,8 +21,15 @@ Eigen::Vector3d VirtualCamera::CentreInWorld() const {
 std::string VirtualCamera::Check() const {
   std::ostringstream error;
   error << "camera '" << name << "': ";
-  if (name.empty() || name.find_first_of(" \t\n/\\") != std::string::npos) {
-    error << "image name must be non-empty and contain no blanks or slashes";
+  // One optional folder level ("SENSOR/NAME", a rig's layout).
+  const size_t slash = name.find('/');
+  const bool bad_folder =
+      slash != std::string::npos &&
+      (slash == 0 || slash + 1 == name.size() || name.find('/', slash + 1) != std::string::npos ||
+       name.compare(0, slash, ".") == 0 || name.compare(0, slash, "..") == 0);
+  if (name.empty() || name.find_first_of(" \t\n\\") != std::string::npos || bad_folder) {
+    error << "image name must be non-empty, contain no blanks and at most one folder "
+             "(SENSOR/NAME)";
     return error.str();
   }
   const int id = ModelIdFromName(model_name);
@@ -55,7 +62,34 @@ std::string VirtualCamera::Check() const {
     error << "pose must have a unit quaternion and a finite translation";
     return error.str();
   }
+  if (!image_circle.allFinite() || image_circle.z() < 0) {
+    error << "image circle must be finite with radius >= 0";
+    return error.str();
+  }
+  if (stitch) {
+    if (stitch->lenses.empty() || !(stitch->band_deg > 0) || !(stitch->distance_m >= 0)) {
+      error << "stitched panorama needs lenses, a blend band > 0 and a distance >= 0";
+      return error.str();
+    }
+    for (const VirtualCamera& lens : stitch->lenses) {
+      if (lens.stitch) {
+        error << "a stitched panorama's lens cannot itself be stitched";
+        return error.str();
+      }
+      const std::string lens_error = lens.Check();
+      if (!lens_error.empty()) {
+        error << "lens " << lens_error;
+        return error.str();
+      }
+    }
+  }
   return "";
+}
+
+bool VirtualCamera::InImageCircle(int col, int row) const {
+  if (image_circle.z() <= 0) return true;
+  const double dx = col + 0.5 - image_circle.x(), dy = row + 0.5 - image_circle.y();
+  return dx * dx + dy * dy <= image_circle.z() * image_circle.z();
 }
 
 VirtualCamera MakeCamera(const std::string& name, const std::string& model_name, int width,
@@ -99,20 +133,83 @@ RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
   const int k = options.supersample;
   const double inv_samples = 1.0 / (k * k);
 
-  // Colour of the scene along the ray through `pixel`; false outside the
-  // model's domain. Range of the hit in `range` (0 if nothing is hit).
-  auto trace = [&](const Eigen::Vector2d& pixel, Eigen::Vector3f* colour, double* range) {
-    Eigen::Vector3d ray_in_cam;
-    if (!RayFromImage(camera.model_id, camera.params, pixel, &ray_in_cam)) return false;
-    const Eigen::Vector3d ray_in_world = (world_from_cam * ray_in_cam).normalized();
+  // A lens of a stitched panorama as the stitcher sees it.
+  struct StitchLens {
+    Eigen::Matrix3d cam_from_world;
+    Eigen::Vector3d centre;
+    Eigen::Vector3d axis;  // optical axis in world
+    const VirtualCamera* camera;
+  };
+  std::vector<StitchLens> stitch_lenses;
+  if (camera.stitch) {
+    for (const VirtualCamera& lens : camera.stitch->lenses) {
+      const Eigen::Matrix3d cam_from_world = lens.cam_from_world_rotation.toRotationMatrix();
+      stitch_lenses.push_back(
+          {cam_from_world, lens.CentreInWorld(), cam_from_world.row(2).transpose(), &lens});
+    }
+  }
+
+  // Colour of the scene along `ray_in_world` from `origin`; range of the hit
+  // in `range` (0 if nothing is hit).
+  auto cast = [&](const Eigen::Vector3d& origin, const Eigen::Vector3d& ray_in_world,
+                  Eigen::Vector3f* colour, double* range) {
     RayHit hit;
-    if (scene.CastRay(centre, ray_in_world, &hit)) {
+    if (scene.CastRay(origin, ray_in_world, &hit)) {
       *colour = scene.Colour(hit.face_id, hit.point);
       *range = hit.range;
     } else {
       colour->setZero();
       *range = 0;
     }
+  };
+
+  // A stitched panorama's colour in direction `d` (world): the blend of the
+  // lenses that see it (see StitchSpec). False if no lens sees it.
+  auto stitched = [&](const Eigen::Vector3d& d, Eigen::Vector3f* colour, double* range) {
+    const StitchSpec& spec = *camera.stitch;
+    std::vector<double> theta(stitch_lenses.size(), 1e9);
+    std::vector<Eigen::Vector3d> dirs(stitch_lenses.size());
+    double theta_min = 1e9;
+    for (size_t k = 0; k < stitch_lenses.size(); ++k) {
+      const StitchLens& lens = stitch_lenses[k];
+      dirs[k] = spec.distance_m > 0 ? (centre + spec.distance_m * d - lens.centre).normalized() : d;
+      Eigen::Vector2d pixel;
+      if (!ImageFromRay(lens.camera->model_id, lens.camera->params, lens.cam_from_world * dirs[k],
+                        &pixel) ||
+          !(pixel.x() >= 0 && pixel.y() >= 0 && pixel.x() < lens.camera->width &&
+            pixel.y() < lens.camera->height) ||
+          !lens.camera->InImageCircle(static_cast<int>(pixel.x()), static_cast<int>(pixel.y()))) {
+        continue;
+      }
+      theta[k] = std::acos(std::clamp(lens.axis.dot(d), -1.0, 1.0));
+      theta_min = std::min(theta_min, theta[k]);
+    }
+    if (theta_min > 1e8) return false;
+    const double band = spec.band_deg * M_PI / 180;
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    double weight_sum = 0, best_weight = 0;
+    for (size_t k = 0; k < stitch_lenses.size(); ++k) {
+      const double weight = std::clamp((theta_min + band - theta[k]) / band, 0.0, 1.0);
+      if (weight <= 0) continue;
+      Eigen::Vector3f lens_colour;
+      double lens_range = 0;
+      cast(stitch_lenses[k].centre, dirs[k], &lens_colour, &lens_range);
+      sum += static_cast<float>(weight) * lens_colour;
+      weight_sum += weight;
+      if (weight > best_weight) best_weight = weight, *range = lens_range;
+    }
+    *colour = sum / static_cast<float>(weight_sum);
+    return true;
+  };
+
+  // Colour of the scene along the ray through `pixel`; false outside the
+  // model's domain. Range of the hit in `range` (0 if nothing is hit).
+  auto trace = [&](const Eigen::Vector2d& pixel, Eigen::Vector3f* colour, double* range) {
+    Eigen::Vector3d ray_in_cam;
+    if (!RayFromImage(camera.model_id, camera.params, pixel, &ray_in_cam)) return false;
+    const Eigen::Vector3d ray_in_world = (world_from_cam * ray_in_cam).normalized();
+    if (camera.stitch) return stitched(ray_in_world, colour, range);
+    cast(centre, ray_in_world, colour, range);
     return true;
   };
 
@@ -122,6 +219,11 @@ RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
     cv::Vec3b* image_row = out.image.ptr<cv::Vec3b>(row);
     float* depth_row = out.depth.ptr<float>(row);
     for (int col = 0; col < width; ++col) {
+      if (!camera.InImageCircle(col, row)) {
+        depth_row[col] = 0;
+        image_row[col] = cv::Vec3b(0, 0, 0);
+        continue;
+      }
       // Pixel (col, row) covers [col, col+1] x [row, row+1]; its centre is
       // (col + 0.5, row + 0.5) (COLMAP convention). Sub-pixel samples are
       // stratified (one per cell of a K x K grid) and N-rooks (all K^2 x and

@@ -5,6 +5,7 @@
 #define SPHERA_SYNTHETIC_RENDER_H_
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,9 +18,12 @@
 namespace sphera {
 namespace synthetic {
 
+struct StitchSpec;
+
 // One image to render: a camera model with its parameters and a pose.
 struct VirtualCamera {
-  std::string name;        // image file name, e.g. "cam000.jpg"
+  // Image file name, e.g. "cam000.jpg"; a rig's images are "SENSOR/NAME".
+  std::string name;
   std::string model_name;  // e.g. "EQUIRECTANGULAR"
   int model_id = -1;
   int width = 0;
@@ -28,11 +32,37 @@ struct VirtualCamera {
   // COLMAP convention: x_cam = cam_from_world_rotation * x_world + cam_from_world_translation.
   Eigen::Quaterniond cam_from_world_rotation = Eigen::Quaterniond::Identity();
   Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
+  // The lens's image circle (cx, cy, radius) in pixels: pixels whose centre
+  // lies outside are black and have no depth (a fisheye lens whose image
+  // circle ends inside the sensor). Radius 0: the whole image.
+  Eigen::Vector3d image_circle = Eigen::Vector3d::Zero();
+  // Rig sensor of the image (empty: not part of a rig).
+  std::string sensor;
+  // Set only for a stitched panorama: its pixels are blended from these
+  // lenses as a stitcher does that assumes they share one centre.
+  std::shared_ptr<const StitchSpec> stitch;
 
   Eigen::Vector3d CentreInWorld() const;
+  // True if the centre of pixel (col, row) lies in the image circle.
+  bool InImageCircle(int col, int row) const;
   // Empty string if valid, else a message naming the camera and the problem
   // (unknown model, wrong parameter count or values, bad size).
   std::string Check() const;
+};
+
+// How a stitched panorama is made from the lens images of one rig frame:
+// the panorama's ray d (in world) is looked up in every lens that sees it
+// from the lens's own centre, along d itself (distance_m = 0: the lenses
+// are assumed to share a centre, i.e. stitched at infinity) or towards the
+// point at distance_m from the panorama's centre (a stitcher's fixed
+// stitching distance). Weights: the lens whose axis is closest to d has
+// weight 1, every other lens k has clamp((theta_min + band - theta_k) /
+// band, 0, 1), where theta is the angle between d and a lens's axis; the
+// weights are normalised (a linear blend across the seam).
+struct StitchSpec {
+  std::vector<VirtualCamera> lenses;
+  double band_deg = 10;
+  double distance_m = 0;
 };
 
 // Builds a camera from a pose given as centre and world_from_cam rotation.

@@ -1,6 +1,7 @@
 // sphera_render: renders the synthetic SPHERA room through any camera model
 // and writes images, depth maps and COLMAP text ground truth.
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <map>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "synthetic/model_io.h"
+#include "synthetic/rig.h"
 
 namespace {
 
@@ -29,6 +31,19 @@ Cameras (a rig file, or a layout):
   --width W --height H   image size (default 2048x1024 equirect, 640x480 perspective,
                          1024x1024 fisheye)
   --camera_params LIST   model parameters, comma separated (default: per model)
+A multi-lens camera moved along a path of frames (see synthetic/rig.h):
+  --rig_preset NAME      dual_fisheye (two back-to-back 200 degree lenses, 3 cm
+                         apart) or ring8 (8 outward 195 degree lenses on a 6 cm ring)
+  --rig_sensors FILE     lines 'NAME MODEL W H PARAMS... | QW QX QY QZ TX TY TZ [MAX_ANGLE_DEG]'
+                         (sensor_from_rig; the first lens is the reference)
+  --frames N             frames on a loop through the room (default 10)
+  --lens_size S          pixels of a preset's square lens images
+  --raw                  also write DIR/raw/: both lenses side by side (two lenses)
+  --stitched             also write DIR/stitched/: the equirectangular panorama a
+                         stitcher makes of every frame (lenses assumed to share a centre)
+  --stitched_width W     panorama width (default 2048)
+  --stitch_band_deg D    blend band across the seam (default 10)
+  --stitch_distance M    stitching distance in metres (default 0: at infinity)
 Scene and rendering:
   --seed S               texture and layout seed (default 0)
   --texture KIND         procedural (default) or checker
@@ -71,19 +86,20 @@ bool ParseDouble(const std::string& text, double* value) {
 int main(int argc, char** argv) {
   using namespace sphera::synthetic;
   std::map<std::string, std::string> args;
-  bool no_boxes = false;
+  bool no_boxes = false, raw = false, stitched = false;
   const std::vector<std::string> value_flags = {
       "--output", "--layout", "--num_cameras", "--model", "--width", "--height",
       "--camera_params", "--rig", "--seed", "--texture", "--checker_size", "--supersample",
-      "--noise_sigma", "--points", "--format", "--num_threads"};
+      "--noise_sigma", "--points", "--format", "--num_threads", "--rig_preset", "--rig_sensors",
+      "--frames", "--lens_size", "--stitched_width", "--stitch_band_deg", "--stitch_distance"};
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
     if (flag == "--help" || flag == "-h") {
       std::cout << kUsage;
       return 0;
     }
-    if (flag == "--no_boxes") {
-      no_boxes = true;
+    if (flag == "--no_boxes" || flag == "--raw" || flag == "--stitched") {
+      (flag == "--no_boxes" ? no_boxes : flag == "--raw" ? raw : stitched) = true;
       continue;
     }
     bool known = false;
@@ -115,8 +131,9 @@ int main(int argc, char** argv) {
   };
 
   if (!args.count("--output")) return Fail("--output DIR is required (see --help)");
-  long long seed, num_cameras, width, height, supersample, points, num_threads;
-  double noise_sigma, checker_size;
+  long long seed, num_cameras, width, height, supersample, points, num_threads, num_frames,
+      lens_size, stitched_width;
+  double noise_sigma, checker_size, stitch_band, stitch_distance;
   if (!get_int("--seed", 0, 0, (1LL << 62), &seed) ||
       !get_int("--num_cameras", 0, 1, 10000, &num_cameras) ||
       !get_int("--width", 0, 1, 65536, &width) || !get_int("--height", 0, 1, 65536, &height) ||
@@ -124,7 +141,12 @@ int main(int argc, char** argv) {
       !get_int("--points", 0, 0, 100000000, &points) ||
       !get_int("--num_threads", 0, 0, 1024, &num_threads) ||
       !get_double("--noise_sigma", 0, &noise_sigma) ||
-      !get_double("--checker_size", 0.25, &checker_size)) {
+      !get_double("--checker_size", 0.25, &checker_size) ||
+      !get_int("--frames", 10, 1, 10000, &num_frames) ||
+      !get_int("--lens_size", 0, 16, 65536, &lens_size) ||
+      !get_int("--stitched_width", 2048, 16, 65536, &stitched_width) ||
+      !get_double("--stitch_band_deg", 10, &stitch_band) ||
+      !get_double("--stitch_distance", 0, &stitch_distance)) {
     return 1;
   }
   const std::string format = args.count("--format") ? args["--format"] : "jpg";
@@ -144,6 +166,64 @@ int main(int argc, char** argv) {
   const std::string scene_error = scene_options.Check();
   if (!scene_error.empty()) return Fail(scene_error);
   const Scene scene(scene_options);
+
+  DatasetOptions options;
+  options.render.supersample = static_cast<int>(supersample);
+  options.render.noise_sigma = noise_sigma;
+  options.render.noise_seed = static_cast<uint64_t>(seed);
+  options.render.num_threads = static_cast<int>(num_threads);
+  options.num_points = static_cast<int>(points);
+  options.points_seed = static_cast<uint64_t>(seed);
+  const auto start = std::chrono::steady_clock::now();
+
+  const bool is_rig = args.count("--rig_preset") || args.count("--rig_sensors");
+  for (const char* flag : {"--frames", "--lens_size", "--stitched_width", "--stitch_band_deg",
+                           "--stitch_distance"}) {
+    if (!is_rig && args.count(flag)) {
+      return Fail(std::string(flag) + " needs --rig_preset or --rig_sensors");
+    }
+  }
+  if (!is_rig && (raw || stitched)) return Fail("--raw and --stitched need a rig");
+  if (is_rig) {
+    if (args.count("--rig_preset") && args.count("--rig_sensors")) {
+      return Fail("give --rig_preset or --rig_sensors, not both");
+    }
+    for (const char* flag : {"--rig", "--layout", "--num_cameras", "--model", "--width",
+                             "--height", "--camera_params"}) {
+      if (args.count(flag)) return Fail(std::string(flag) + " cannot be combined with a rig");
+    }
+    if (args.count("--lens_size") && args.count("--rig_sensors")) {
+      return Fail("--lens_size applies to --rig_preset only");
+    }
+    if (!(stitch_band > 0 && stitch_band <= 90)) return Fail("--stitch_band_deg must be in (0, 90]");
+    if (!(stitch_distance >= 0 && std::isfinite(stitch_distance))) {
+      return Fail("--stitch_distance must be >= 0");
+    }
+    std::vector<RigSensor> sensors;
+    const std::string rig_error =
+        args.count("--rig_preset")
+            ? MakeRigPreset(args["--rig_preset"], static_cast<int>(lens_size), &sensors)
+            : ReadRigSensors(args["--rig_sensors"], &sensors);
+    if (!rig_error.empty()) return Fail(rig_error);
+    RigDatasetOptions rig_options;
+    rig_options.dataset = options;
+    rig_options.image_extension = extension;
+    rig_options.raw = raw;
+    rig_options.stitched = stitched;
+    rig_options.stitched_width = static_cast<int>(stitched_width);
+    rig_options.stitch_band_deg = stitch_band;
+    rig_options.stitch_distance_m = stitch_distance;
+    const std::string error =
+        WriteRigDataset(args["--output"], scene,
+                        sensors, MakeFramePath(static_cast<int>(num_frames),
+                                               static_cast<uint64_t>(seed)),
+                        rig_options, &std::cout);
+    if (!error.empty()) return Fail(error);
+    std::cout << "total "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+              << " s\n";
+    return 0;
+  }
 
   std::vector<VirtualCamera> cameras;
   if (args.count("--rig")) {
@@ -170,14 +250,6 @@ int main(int argc, char** argv) {
     if (!error.empty()) return Fail(error);
   }
 
-  DatasetOptions options;
-  options.render.supersample = static_cast<int>(supersample);
-  options.render.noise_sigma = noise_sigma;
-  options.render.noise_seed = static_cast<uint64_t>(seed);
-  options.render.num_threads = static_cast<int>(num_threads);
-  options.num_points = static_cast<int>(points);
-  options.points_seed = static_cast<uint64_t>(seed);
-  const auto start = std::chrono::steady_clock::now();
   const std::string error = WriteDataset(args["--output"], scene, cameras, options, &std::cout);
   if (!error.empty()) return Fail(error);
   std::cout << "total "

@@ -739,6 +739,24 @@ SphereExportSummary ExportPerspectiveWorkspace(
       cached_maps.clear();
       cached_camera_id = camera.camera_id;
     }
+    // The source's mask: its file, or every pixel valid.
+    cv::Mat source_mask;
+    if (!options.mask_path.empty()) {
+      const fs::path mask_file =
+          fs::path(options.mask_path) / (image.Name() + ".png");
+      if (fs::exists(mask_file)) {
+        source_mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
+        if (source_mask.empty() || source_mask.cols != source_image.cols ||
+            source_mask.rows != source_image.rows) {
+          throw std::invalid_argument(
+              "mask " + mask_file.string() + " of image " + image.Name() +
+              " is unreadable or not the image's size");
+        }
+      } else {
+        source_mask = cv::Mat(source_image.rows, source_image.cols, CV_8U,
+                              cv::Scalar(255));
+      }
+    }
 
     // Source rays of the 2D points.
     const std::vector<Point2D>& points2D = image.Points2D();
@@ -824,6 +842,19 @@ SphereExportSummary ExportPerspectiveWorkspace(
       WriteImage((images_dir / view.name).string(),
                  RemapImage(source_image, camera, maps),
                  options);
+      if (!source_mask.empty()) {
+        cv::Mat view_mask;
+        cv::threshold(RemapImage(source_mask, camera, maps),
+                      view_mask,
+                      127,
+                      255,
+                      cv::THRESH_BINARY);
+        const fs::path masks_dir = temp / "masks";
+        CreateFolders(masks_dir, view.name);
+        WriteImage((masks_dir / (view.name + ".png")).string(),
+                   view_mask,
+                   options);
+      }
       exported.AddImageWithTrivialFrame(std::move(view_image),
                                         view_from_world);
       view_names.push_back(view.name);

@@ -78,6 +78,12 @@ struct SphereUndistorterOptions {
   std::string image_format = "jpg";
   // JPEG quality of the face images, in [1, 100].
   int jpeg_quality = 95;
+  // Masks of the source images (ImageReader.mask_path's layout: MASK_PATH/
+  // NAME.png, 0 = ignore, e.g. a fisheye lens's image circle or a user's
+  // mask). When set, every view gets OUTPUT/masks/VIEW_NAME.png: the source
+  // mask carried into the view (nearest pixel), 0 where the view sees no
+  // source pixel. An image without a mask file counts as unmasked.
+  std::string mask_path;
 
   // Empty when valid; otherwise a message naming the offending option.
   std::string Check() const;

@@ -1,6 +1,8 @@
 #include "colmap_ext/exe/sphera_commands.h"
 
+#include "colmap_ext/exe/dual_fisheye_splitter.h"
 #include "colmap_ext/exe/model_evaluator.h"
+#include "colmap_ext/exe/rig_calibration.h"
 #include "colmap_ext/exe/sphere_bundle_adjuster.h"
 #include "colmap_ext/exe/sphere_undistorter.h"
 #include "colmap_ext/exe/strecha_importer.h"
@@ -9,7 +11,9 @@ namespace colmap {
 
 std::vector<std::pair<std::string, SpheraCommandFunc>> SpheraCommands() {
   return {
+      {"dual_fisheye_splitter", &RunDualFisheyeSplitter},
       {"model_evaluator", &RunModelEvaluator},
+      {"rig_calibration", &RunRigCalibration},
       {"sphere_bundle_adjuster", &RunSphereBundleAdjuster},
       {"sphere_undistorter", &RunSphereUndistorter},
       {"strecha_importer", &RunStrechaImporter},

@@ -41,6 +41,7 @@ int RunSphereUndistorter(int argc, char** argv) {
   options.AddDefaultOption(
       "image_format", &export_options.image_format, "{jpg, png}");
   options.AddDefaultOption("jpeg_quality", &export_options.jpeg_quality);
+  options.AddDefaultOption("mask_path", &export_options.mask_path);
   if (!options.Parse(argc, argv)) {
     return EXIT_FAILURE;
   }

@@ -1,0 +1,71 @@
+#include "colmap_ext/scene/intrinsics_divergence.h"
+
+#include <limits>
+
+#include <gtest/gtest.h>
+
+namespace colmap {
+namespace {
+
+Camera MakeCamera(const std::string& model, std::vector<double> params) {
+  Camera camera = Camera::CreateFromModelName(1, model, 1, 1024, 1024);
+  camera.params = std::move(params);
+  return camera;
+}
+
+TEST(IntrinsicsDivergence, PlausibleRefinementsPass) {
+  const Camera prior = MakeCamera("EUCM", {280, 280, 512, 512, 0.6, 1.0});
+  // 20% off either way, slightly non-square, shape parameters moved.
+  EXPECT_EQ(IntrinsicsDivergence(
+                prior, MakeCamera("EUCM", {236, 236.5, 512, 512, 0.62, 1.05})),
+            "");
+  EXPECT_EQ(IntrinsicsDivergence(
+                prior, MakeCamera("EUCM", {336, 335, 510, 515, 0.58, 0.95})),
+            "");
+  const Camera pinhole = MakeCamera("PINHOLE", {500, 500, 512, 512});
+  EXPECT_EQ(IntrinsicsDivergence(pinhole,
+                                 MakeCamera("PINHOLE", {700, 690, 512, 512})),
+            "");
+  const Camera panorama = MakeCamera("EQUIRECTANGULAR", {1024, 1024});
+  EXPECT_EQ(IntrinsicsDivergence(panorama, panorama), "");
+}
+
+TEST(IntrinsicsDivergence, RunawaysAreNamed) {
+  const Camera prior = MakeCamera("EUCM", {280, 280, 512, 512, 0.6, 1.0});
+  // The real 197° lens of the issue: fx = 97,205, fy = 29.
+  std::string why = IntrinsicsDivergence(
+      prior, MakeCamera("EUCM", {97205, 29, 512, 512, 0.6, 1.0}));
+  EXPECT_NE(why.find("focal length went from 280"), std::string::npos) << why;
+  EXPECT_NE(why.find("fy 29"), std::string::npos) << why;
+  // Within the focal ratio but no longer square.
+  why = IntrinsicsDivergence(prior,
+                             MakeCamera("EUCM", {330, 250, 512, 512, 0.6, 1.0}));
+  EXPECT_NE(why.find("fx / fy"), std::string::npos) << why;
+  // A camera whose prior is not square may stay so.
+  const Camera oblong = MakeCamera("EUCM", {330, 250, 512, 512, 0.6, 1.0});
+  EXPECT_EQ(IntrinsicsDivergence(
+                oblong, MakeCamera("EUCM", {331, 251, 512, 512, 0.6, 1.0})),
+            "");
+  // Focal length 5x off.
+  why = IntrinsicsDivergence(
+      prior, MakeCamera("EUCM", {1400, 1400, 512, 512, 0.6, 1.0}));
+  EXPECT_NE(why.find("focal length"), std::string::npos) << why;
+  // Outside the model's valid range (EUCM: alpha in [0, 1]).
+  why = IntrinsicsDivergence(prior,
+                             MakeCamera("EUCM", {280, 280, 512, 512, 1.7, 1.0}));
+  EXPECT_NE(why.find("valid range of EUCM"), std::string::npos) << why;
+  // Not finite.
+  why = IntrinsicsDivergence(
+      prior,
+      MakeCamera("EUCM", {std::numeric_limits<double>::quiet_NaN(), 280, 512,
+                          512, 0.6, 1.0}));
+  EXPECT_NE(why.find("not finite"), std::string::npos) << why;
+  // Principal point outside the image.
+  why = IntrinsicsDivergence(
+      MakeCamera("PINHOLE", {500, 500, 512, 512}),
+      MakeCamera("PINHOLE", {500, 500, -40, 512}));
+  EXPECT_FALSE(why.empty());
+}
+
+}  // namespace
+}  // namespace colmap

@@ -1,0 +1,413 @@
+#!/usr/bin/python3
+"""Benchmark of multi-lens 360° cameras: the raw rig against the stitched
+panorama and against one lens alone, on the same rendered frames.
+
+For every seed and preset, sphera_render renders a rig along a loop of
+frames (dual_fisheye: two back-to-back 200° lenses 3 cm apart, also the raw
+side-by-side frames and the equirectangular panoramas a stitcher makes of
+them; ring8: 8 outward 195° lenses on a 6 cm ring). Each system runs the
+COLMAP command line (feature_extractor, rig_configurator where it applies,
+exhaustive_matcher, mapper) and is scored per frame against the ground
+truth:
+
+  rig        SPHERA: every lens image, one camera per lens with the lens's
+             image-circle mask, rig_configurator with a start that only
+             knows the lenses' directions (no offsets), frames mapped as rigs
+  stitched   SPHERA on the stitched panoramas (EQUIRECTANGULAR), one per
+             frame (dual_fisheye only)
+  stitched_upstream  unpatched upstream COLMAP 4.x on the same panoramas
+             (--upstream_colmap; left out with --no_upstream)
+  one_lens   SPHERA on lens 0's images alone (one 200° or 195° lens)
+
+A frame's position is the mean of its lens centres for the rig (the
+stitched panorama's centre, where the ground truth puts the panorama), lens
+0's centre for one_lens; its rotation is lens 0's (the panorama is oriented
+as lens 0). Each model is aligned to the ground truth by the least-squares
+similarity of these positions (Umeyama); errors are the angle of
+R_gt R_est^T and the distance of the aligned positions. For the rig, the
+recovered sensor_from_rig of every lens is compared with the truth
+(rotation angle, lens centre in the rig scaled by the alignment's scale).
+
+Usage (from the repository root, after scripts/build.sh):
+  scripts/benchmark_rig.py                        3 seeds, both presets
+  scripts/benchmark_rig.py --repeats 1 --presets dual_fisheye --frames 10
+Output (--output, default build/bench_rig): rig_runs.csv (every run),
+rig_results.csv (median and min..max per preset and system, ratios to the
+rig), rig_results.png, logs/.
+"""
+import argparse
+import csv
+import os
+import shutil
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import sphera_common as common  # noqa: E402
+
+REPO = common.REPO_ROOT
+
+
+def log(message):
+    print(f"[{time.strftime('%H:%M:%S')}] {message}", flush=True)
+
+
+def timed(program, args, log_path, timeout=3600):
+    """Runs PROGRAM ARGS logging into LOG_PATH; returns seconds. A failure
+    raises RuntimeError with the log's end."""
+    code, seconds = common.run_logged([program, *map(str, args)], log_path,
+                                      timeout)
+    if code != 0:
+        with open(log_path, errors="replace") as f:
+            tail = f.read()[-1500:]
+        raise RuntimeError(f"{os.path.basename(log_path)}: exit {code}\n"
+                           f"{tail}")
+    return seconds
+
+
+def frame_of(name):
+    """The frame an image belongs to: 'lens0/frame003.jpg' and
+    'frame003.jpg' are frame 'frame003.jpg'."""
+    return name.split("/")[-1]
+
+
+def frame_poses(model_path, system, num_lenses):
+    """{frame: (R of lens 0 or the panorama, position)} of a text model."""
+    import numpy as np
+    poses = common.text_model_poses(model_path)
+    frames = {}
+    for name, (rotation, centre) in poses.items():
+        frames.setdefault(frame_of(name), {})[name.split("/")[0]
+                                              if "/" in name else ""] = (
+            rotation, centre)
+    result = {}
+    for frame, lenses in frames.items():
+        if system == "rig":
+            if len(lenses) != num_lenses or "lens0" not in lenses:
+                continue  # a frame is registered with all its lenses
+            position = np.mean([c for _, c in lenses.values()], axis=0)
+            result[frame] = (lenses["lens0"][0], position)
+        else:
+            (rotation, centre), = lenses.values()
+            result[frame] = (rotation, centre)
+    return result
+
+
+def rough_rig_config(scene, path):
+    """rig_config.json of the scene with every lens's offset set to zero:
+    what a user knows of a camera (lens directions), not its calibration."""
+    import json
+    with open(os.path.join(scene, "rig_config.json")) as f:
+        config = json.load(f)
+    for camera in config[0]["cameras"]:
+        if not camera.get("ref_sensor"):
+            camera["cam_from_rig_translation"] = [0, 0, 0]
+    with open(path, "w") as f:
+        json.dump(config, f, indent=1)
+
+
+def run_system(scene, preset, system, work, program, num_lenses):
+    """Reconstructs SCENE with SYSTEM; returns a row of results."""
+    import json
+    os.makedirs(work)
+    logs = os.path.join(work, "logs")
+    os.makedirs(logs)
+    database = os.path.join(work, "database.db")
+    row = {"preset": preset, "system": system}
+    extraction = ["--FeatureExtraction.use_gpu", "0"]
+    with open(os.path.join(scene, "rig_config.json")) as f:
+        lens0 = json.load(f)[0]["cameras"][0]
+    if system == "rig":
+        image_path = os.path.join(scene, "images")
+        t_extract = timed(program, [
+            "feature_extractor", "--database_path", database, "--image_path",
+            image_path, "--ImageReader.camera_model", lens0["camera_model_name"],
+            "--ImageReader.single_camera_per_folder", "1",
+            "--ImageReader.mask_path", os.path.join(scene, "masks"),
+            *extraction], os.path.join(logs, "extract.log"))
+        config = os.path.join(work, "rig_config.json")
+        rough_rig_config(scene, config)
+        t_extract += timed(program, [
+            "rig_configurator", "--database_path", database,
+            "--rig_config_path", config], os.path.join(logs, "rig.log"))
+    elif system == "one_lens":
+        image_path = os.path.join(scene, "images")
+        list_path = os.path.join(work, "images.txt")
+        with open(list_path, "w") as f:
+            for name in sorted(os.listdir(os.path.join(image_path, "lens0"))):
+                f.write(f"lens0/{name}\n")
+        t_extract = timed(program, [
+            "feature_extractor", "--database_path", database, "--image_path",
+            image_path, "--image_list_path", list_path,
+            "--ImageReader.camera_model", lens0["camera_model_name"],
+            "--ImageReader.camera_params",
+            ",".join("%.17g" % p for p in lens0["camera_params"]),
+            "--ImageReader.single_camera", "1",
+            "--ImageReader.mask_path", os.path.join(scene, "masks"),
+            *extraction], os.path.join(logs, "extract.log"))
+    else:
+        image_path = os.path.join(scene, "stitched", "images")
+        t_extract = timed(program, [
+            "feature_extractor", "--database_path", database, "--image_path",
+            image_path, "--ImageReader.camera_model", "EQUIRECTANGULAR",
+            "--ImageReader.single_camera", "1", *extraction],
+            os.path.join(logs, "extract.log"))
+    t_match = timed(program, ["exhaustive_matcher", "--database_path",
+                              database, "--FeatureMatching.use_gpu", "0"],
+                    os.path.join(logs, "match.log"))
+    sparse = os.path.join(work, "sparse")
+    os.makedirs(sparse)
+    t_map = timed(program, ["mapper", "--database_path", database,
+                            "--image_path", image_path, "--output_path",
+                            sparse], os.path.join(logs, "map.log"))
+    row.update(t_extract_s=t_extract, t_match_s=t_match, t_map_s=t_map,
+               t_total_s=t_extract + t_match + t_map)
+    models = sorted(os.listdir(sparse))
+    row["models"] = len(models)
+    if not models:
+        row["error"] = "no model"
+        return row
+    # The model with the most images.
+    best, best_count = None, -1
+    for model in models:
+        text = os.path.join(work, "text_" + model)
+        common.model_to_text(os.path.join(sparse, model), text)
+        count = len(common.read_text_images(text))
+        if count > best_count:
+            best, best_count = text, count
+    kind = "rig" if system == "rig" else (
+        "one_lens" if system == "one_lens" else "stitched")
+    gt_dir = os.path.join(scene, "stitched", "sparse_gt") \
+        if kind == "stitched" else os.path.join(scene, "sparse_gt")
+    gt = frame_poses(gt_dir, "rig" if kind == "rig" else "single", num_lenses)
+    if kind == "one_lens":
+        gt = {f: (r, c) for f, (r, c) in _lens_poses(gt_dir, "lens0").items()}
+        est = _lens_poses(best, "lens0")
+    else:
+        est = frame_poses(best, "rig" if kind == "rig" else "single",
+                          num_lenses)
+    errors = common.aligned_pose_errors(gt, est)
+    row["frames"] = len(gt)
+    row["registered"] = len(errors)
+    if errors:
+        rotations = sorted(e[0] for e in errors.values())
+        positions = sorted(e[1] for e in errors.values())
+        row.update(rot_median_deg=common.median(rotations),
+                   rot_max_deg=rotations[-1],
+                   pos_median_mm=1000 * common.median(positions),
+                   pos_max_mm=1000 * positions[-1])
+    if kind == "rig":
+        rig = common.rig_errors(os.path.join(scene, "sparse_gt"), best)
+        if rig:
+            row["rig_rot_max_deg"] = max(r for r, _ in rig.values())
+            row["rig_pos_max_mm"] = 1000 * max(c for _, c in rig.values())
+    return row
+
+
+def _lens_poses(model_path, lens):
+    """{frame: (R, centre)} of the images of one lens of a text model."""
+    return {frame_of(name): pose
+            for name, pose in common.text_model_poses(model_path).items()
+            if name.startswith(lens + "/")}
+
+
+COLUMNS = ["preset", "system", "seed", "frames", "registered", "models",
+           "rot_median_deg", "rot_max_deg", "pos_median_mm", "pos_max_mm",
+           "rig_rot_max_deg", "rig_pos_max_mm", "t_extract_s", "t_match_s",
+           "t_map_s", "t_total_s", "error"]
+SPREAD = ["rot_median_deg", "pos_median_mm", "pos_max_mm", "rig_rot_max_deg",
+          "rig_pos_max_mm", "t_total_s"]
+
+
+def summarize(runs):
+    groups = {}
+    for run in runs:
+        groups.setdefault((run["preset"], run["system"]), []).append(run)
+    summary = []
+    for (preset, system), rows in groups.items():
+        out = {"preset": preset, "system": system, "runs": len(rows),
+               "failed": sum(1 for r in rows if r.get("error"))}
+        for key in COLUMNS[3:-1]:
+            values = [float(r[key]) for r in rows
+                      if r.get(key) not in (None, "")]
+            if values:
+                out[key] = common.median(values)
+                if key in SPREAD:
+                    out[key + "_min"] = min(values)
+                    out[key + "_max"] = max(values)
+        summary.append(out)
+    # Ratios of every system's median position and rotation error to the
+    # rig's of the same preset.
+    for row in summary:
+        rig = next((r for r in summary if r["preset"] == row["preset"]
+                    and r["system"] == "rig"), None)
+        for key in ("pos_median_mm", "rot_median_deg", "t_total_s"):
+            if rig and rig.get(key) and row.get(key) is not None:
+                row[key + "_vs_rig"] = row[key] / rig[key]
+    return summary
+
+
+def fmt(value, digits=3):
+    if value is None or value == "":
+        return "-"
+    if isinstance(value, float):
+        return f"{value:.{digits}g}"
+    return str(value)
+
+
+def print_table(summary):
+    header = ["preset", "system", "reg/frames", "rot med deg", "pos med mm",
+              "pos max mm", "rig rot deg", "rig pos mm", "time s",
+              "pos / rig"]
+    lines = [header]
+    for row in summary:
+        def cell(key):
+            if key + "_min" in row:
+                return (f"{fmt(row.get(key))} [{fmt(row[key + '_min'])}.."
+                        f"{fmt(row[key + '_max'])}]")
+            return fmt(row.get(key))
+        lines.append([row["preset"], row["system"],
+                      f"{fmt(row.get('registered'))}/{fmt(row.get('frames'))}",
+                      cell("rot_median_deg"), cell("pos_median_mm"),
+                      cell("pos_max_mm"), cell("rig_rot_max_deg"),
+                      cell("rig_pos_max_mm"), cell("t_total_s"),
+                      fmt(row.get("pos_median_mm_vs_rig"))])
+    widths = [max(len(str(line[i])) for line in lines)
+              for i in range(len(header))]
+    for line in lines:
+        print("  ".join(str(v).ljust(w) for v, w in zip(line, widths)))
+
+
+def write_csv(path, rows):
+    keys = []
+    for row in rows:
+        keys += [k for k in row if k not in keys]
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=keys)
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def write_png(path, summary):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    presets = sorted({r["preset"] for r in summary})
+    systems = ["rig", "stitched", "stitched_upstream", "one_lens"]
+    colours = {"rig": "tab:green", "stitched": "tab:orange",
+               "stitched_upstream": "tab:red", "one_lens": "tab:blue"}
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    for ax, key, title in zip(
+            axes, ("pos_median_mm", "rot_median_deg", "t_total_s"),
+            ("position error (median over frames), mm",
+             "rotation error (median over frames), deg",
+             "time of the pipeline, s")):
+        width = 0.8 / len(systems)
+        for s, system in enumerate(systems):
+            xs, ys, lo, hi = [], [], [], []
+            for p, preset in enumerate(presets):
+                row = next((r for r in summary if r["preset"] == preset
+                            and r["system"] == system), None)
+                if not row or row.get(key) is None:
+                    continue
+                xs.append(p + (s - 1.5) * width)
+                ys.append(row[key])
+                lo.append(row[key] - row.get(key + "_min", row[key]))
+                hi.append(row.get(key + "_max", row[key]) - row[key])
+            if xs:
+                ax.bar(xs, ys, width, yerr=[lo, hi], capsize=3,
+                       color=colours[system], label=system)
+        ax.set_xticks(range(len(presets)))
+        ax.set_xticklabels(presets)
+        if key != "t_total_s":
+            ax.set_yscale("log")
+        ax.set_title(title, fontsize=10)
+    axes[0].legend(fontsize=8)
+    fig.suptitle("Raw rig vs stitched panorama vs one lens: median and "
+                 "min..max over seeds")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def main():
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    parser.add_argument("--repeats", type=int, default=3,
+                        help="seeds 0..N-1: each renders its own scene")
+    parser.add_argument("--presets", default="dual_fisheye,ring8")
+    parser.add_argument("--systems",
+                        default="rig,stitched,stitched_upstream,one_lens")
+    parser.add_argument("--frames", type=int, default=10)
+    parser.add_argument("--lens_size", type=int, default=0,
+                        help="pixels of a lens image (0: the preset's)")
+    parser.add_argument("--stitched_width", type=int, default=2048)
+    parser.add_argument("--supersample", type=int, default=2,
+                        help="rays per pixel side of the renders")
+    parser.add_argument("--output", default=os.path.join(REPO, "build",
+                                                         "bench_rig"))
+    parser.add_argument("--colmap", default=os.path.join(REPO, "build", "bin",
+                                                         "colmap"))
+    parser.add_argument("--render", default=os.path.join(
+        REPO, "build", "synthetic", "sphera_render"))
+    parser.add_argument("--upstream_colmap", default=common.UPSTREAM_COLMAP)
+    parser.add_argument("--no_upstream", action="store_true")
+    args = parser.parse_args()
+
+    systems = args.systems.split(",")
+    if args.no_upstream and "stitched_upstream" in systems:
+        systems.remove("stitched_upstream")
+    if "stitched_upstream" in systems and not os.path.exists(
+            args.upstream_colmap):
+        sys.exit(f"benchmark_rig: no upstream COLMAP at "
+                 f"{args.upstream_colmap} (../shared/peers/build_colmap4.sh "
+                 f"builds it; or --no_upstream)")
+    for path in (args.colmap, args.render):
+        if not os.path.exists(path):
+            sys.exit(f"benchmark_rig: {path} is missing (scripts/build.sh)")
+    os.makedirs(args.output, exist_ok=True)
+    runs = []
+    for seed in range(args.repeats):
+        for preset in args.presets.split(","):
+            scene = os.path.join(args.output, f"scene_{preset}_{seed}")
+            if not os.path.exists(os.path.join(scene, "sparse_gt")):
+                shutil.rmtree(scene, ignore_errors=True)
+                render = ["--rig_preset", preset, "--frames", args.frames,
+                          "--seed", seed, "--supersample", args.supersample]
+                if args.lens_size:
+                    render += ["--lens_size", args.lens_size]
+                if preset == "dual_fisheye":
+                    render += ["--stitched", "--stitched_width",
+                               args.stitched_width]
+                log(f"render {preset} seed {seed}")
+                common.run_render(scene, *render, program=args.render)
+            num_lenses = len(common.read_text_cameras(
+                os.path.join(scene, "sparse_gt")))
+            for system in systems:
+                if system.startswith("stitched") and preset != "dual_fisheye":
+                    continue
+                program = args.upstream_colmap \
+                    if system == "stitched_upstream" else args.colmap
+                work = os.path.join(args.output, f"run_{preset}_{system}_{seed}")
+                shutil.rmtree(work, ignore_errors=True)
+                log(f"{preset} {system} seed {seed}")
+                try:
+                    row = run_system(scene, preset, system, work, program,
+                                     num_lenses)
+                except (RuntimeError, OSError, ValueError) as error:
+                    row = {"preset": preset, "system": system,
+                           "error": str(error).splitlines()[0]}
+                row["seed"] = seed
+                log("  " + ", ".join(f"{k}={fmt(v)}" for k, v in row.items()
+                                     if k not in ("preset", "system")))
+                runs.append(row)
+                write_csv(os.path.join(args.output, "rig_runs.csv"), runs)
+    summary = summarize(runs)
+    write_csv(os.path.join(args.output, "rig_results.csv"), summary)
+    write_png(os.path.join(args.output, "rig_results.png"), summary)
+    print_table(summary)
+    print(f"\nwrote {args.output}/rig_runs.csv, rig_results.csv, "
+          f"rig_results.png")
+
+
+if __name__ == "__main__":
+    main()
