@@ -179,11 +179,12 @@ def run_system(scene, preset, system, work, program, num_lenses):
         "one_lens" if system == "one_lens" else "stitched")
     gt_dir = os.path.join(scene, "stitched", "sparse_gt") \
         if kind == "stitched" else os.path.join(scene, "sparse_gt")
-    gt = frame_poses(gt_dir, "rig" if kind == "rig" else "single", num_lenses)
     if kind == "one_lens":
-        gt = {f: (r, c) for f, (r, c) in _lens_poses(gt_dir, "lens0").items()}
+        gt = _lens_poses(gt_dir, "lens0")
         est = _lens_poses(best, "lens0")
     else:
+        gt = frame_poses(gt_dir, "rig" if kind == "rig" else "single",
+                         num_lenses)
         est = frame_poses(best, "rig" if kind == "rig" else "single",
                           num_lenses)
     errors = common.aligned_pose_errors(gt, est)
@@ -365,7 +366,20 @@ def main():
         if not os.path.exists(path):
             sys.exit(f"benchmark_rig: {path} is missing (scripts/build.sh)")
     os.makedirs(args.output, exist_ok=True)
+    # model_to_text and friends run this colmap.
+    common.COLMAP = args.colmap
+    # Runs of an earlier call into the same output that this one does not
+    # repeat are kept (e.g. --systems one_lens after a full run).
     runs = []
+    runs_csv = os.path.join(args.output, "rig_runs.csv")
+    if os.path.exists(runs_csv):
+        with open(runs_csv) as f:
+            runs = [{k: v for k, v in row.items() if v != ""}
+                    for row in csv.DictReader(f)]
+        runs = [row for row in runs
+                if row.get("system") not in systems
+                or int(row.get("seed", -1)) >= args.repeats
+                or row.get("preset") not in args.presets.split(",")]
     for seed in range(args.repeats):
         for preset in args.presets.split(","):
             scene = os.path.join(args.output, f"scene_{preset}_{seed}")
@@ -400,7 +414,7 @@ def main():
                 log("  " + ", ".join(f"{k}={fmt(v)}" for k, v in row.items()
                                      if k not in ("preset", "system")))
                 runs.append(row)
-                write_csv(os.path.join(args.output, "rig_runs.csv"), runs)
+                write_csv(runs_csv, runs)
     summary = summarize(runs)
     write_csv(os.path.join(args.output, "rig_results.csv"), summary)
     write_png(os.path.join(args.output, "rig_results.png"), summary)

@@ -149,7 +149,7 @@ make_seeds() {
   # with prefixes and a reference only.
   for preset in dual_fisheye ring8; do
     "${RENDER}" --output "${WORK}/rig_${preset}" --rig_preset "${preset}" \
-      --frames 1 --lens_size 32 --supersample 1 >/dev/null
+      --frames 1 --lens_size 64 --supersample 1 >/dev/null
     cp "${WORK}/rig_${preset}/rig_config.json" "${seeds}/fuzz_rig_config/${preset}.json"
   done
   printf '[{"cameras": [{"image_prefix": "a/", "ref_sensor": true}, %s]}]\n' \

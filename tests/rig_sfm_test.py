@@ -11,8 +11,9 @@ import json
 import os
 import shutil
 
-from cli_util import TempDirTestCase, main_with_render
-from sphera_common import (extract_features, match_exhaustive, median,
+from cli_util import (Database, TempDirTestCase, main_with_render,
+                      write_noise_image)
+from sphera_common import (CPU_EXTRACTION, extract_features, match_exhaustive, median,
                            model_to_text, pose_errors, read_text_cameras, read_text_images,
                            rig_errors, run_colmap, run_render)
 
@@ -109,6 +110,52 @@ class SplitRenderedRawTest(TempDirTestCase):
                             int((mask != rendered_mask).sum()), 0, name)
                         self.assertGreater(int((mask == 255).sum()),
                                            0.6 * mask.size)
+
+
+class SuffixFramesTest(TempDirTestCase):
+    """Cameras that write NAME_1.JPG ... NAME_k.JPG (Vuze-style) form frames
+    by the part before the suffix ("image_suffix" in the rig config)."""
+
+    def test_images_group_into_frames_by_suffix(self):
+        images = self.path("images")
+        os.makedirs(images)
+        for frame in ("A", "B", "C"):
+            for lens in (1, 2):
+                write_noise_image(os.path.join(images, f"{frame}_{lens}.pgm"),
+                                  96, 96, seed=ord(frame) * 10 + lens)
+        database = self.path("database.db")
+        # One camera per lens: one extraction per lens.
+        for lens in (1, 2):
+            names = self.path(f"lens{lens}.txt")
+            with open(names, "w") as f:
+                f.write("".join(f"{frame}_{lens}.pgm\n" for frame in "ABC"))
+            run_colmap("feature_extractor", "--database_path", database,
+                       "--image_path", images, "--image_list_path", names,
+                       "--ImageReader.single_camera", "1",
+                       *CPU_EXTRACTION)
+        config = self.path("rig.json")
+        with open(config, "w") as f:
+            json.dump([{"cameras": [
+                {"image_prefix": "", "image_suffix": "_1.pgm",
+                 "ref_sensor": True},
+                {"image_prefix": "", "image_suffix": "_2.pgm",
+                 "cam_from_rig_rotation": [0, 0, 1, 0],
+                 "cam_from_rig_translation": [0, 0, -0.06]}]}], f)
+        run_colmap("rig_configurator", "--database_path", database,
+                   "--rig_config_path", config)
+        db = Database(database)
+        names = {image_id: name for image_id, name in db.connection.execute(
+            "SELECT image_id, name FROM images")}
+        frames = {}
+        for frame_id, data_id in db.connection.execute(
+                "SELECT frame_id, data_id FROM frame_data"):
+            frames.setdefault(frame_id, []).append(names[data_id])
+        rigs = db.scalar("SELECT COUNT(*) FROM rigs")
+        db.close()
+        self.assertEqual(sorted(sorted(v) for v in frames.values()),
+                         [[f"{frame}_1.pgm", f"{frame}_2.pgm"]
+                          for frame in "ABC"])
+        self.assertEqual(rigs, 1)
 
 
 class DualFisheyeRigTest(TempDirTestCase):
