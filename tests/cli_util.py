@@ -40,6 +40,18 @@ def write_noise_image(path, width, height, seed, gray=True):
         f.write(bytes(pixels))
 
 
+def listing(root):
+    """{relative path: size in bytes (-1 for a folder)} of everything below
+    ROOT: what a failed command must not have written or changed."""
+    result = {}
+    for folder, dirs, files in os.walk(root):
+        for name in dirs + files:
+            path = os.path.join(folder, name)
+            result[os.path.relpath(path, root)] = (
+                os.path.getsize(path) if os.path.isfile(path) else -1)
+    return result
+
+
 class Database:
     """Read-only view of a COLMAP database."""
 

@@ -16,7 +16,7 @@ import unittest
 import numpy as np
 from PIL import Image
 
-from cli_util import Database, TempDirTestCase
+from cli_util import Database, TempDirTestCase, listing
 from sphera_common import CPU_EXTRACTION, run_colmap
 
 # Lens images W x H (not square, to catch a swapped axis) and image circles
@@ -61,17 +61,6 @@ def save(path, array):
 def load(path):
     with Image.open(path) as image:
         return np.array(image)
-
-
-def listing(root):
-    """Relative paths of all files and folders below ROOT, and their sizes."""
-    result = {}
-    for folder, dirs, files in os.walk(root):
-        for name in dirs + files:
-            path = os.path.join(folder, name)
-            result[os.path.relpath(path, root)] = (
-                os.path.getsize(path) if os.path.isfile(path) else -1)
-    return result
 
 
 def circles_arg(circles):

@@ -8,7 +8,7 @@ import struct
 import zlib
 
 import sphera_common
-from cli_util import TempDirTestCase
+from cli_util import TempDirTestCase, listing
 from sphera_common import mat_vec, model_to_text, rotation_matrix, run_colmap
 
 import unittest
@@ -106,17 +106,6 @@ def read_text_model(path):
             {fields[9]: (int(fields[8]), observations)
              for fields, observations in images.values()},
             {point_id: len(track) for point_id, (_, track) in points.items()})
-
-
-def listing(root):
-    """Relative paths and sizes of everything under root."""
-    result = {}
-    for folder, dirs, files in os.walk(root):
-        for name in dirs + files:
-            path = os.path.join(folder, name)
-            result[os.path.relpath(path, root)] = (
-                os.path.getsize(path) if os.path.isfile(path) else -1)
-    return result
 
 
 FACES = ["front", "right", "back", "left", "up", "down"]
