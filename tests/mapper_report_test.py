@@ -1,13 +1,17 @@
 """The mapper's per-image report: every image of the run is accounted for,
 registered in a model or named with the reason it is in none (no keypoints,
 no verified pair, no pose), a split into several models is pointed out, and a
-run that makes no model exits non-zero with the same report."""
+run that makes no model exits non-zero with the same report; a camera whose
+self-calibration leaves the bounds --Mapper.hold_focal_ratio /
+--Mapper.hold_aspect_change set is held at its value before that bundle
+adjustment and named in the report."""
 import os
 import re
 
 from cli_util import (Database, TempDirTestCase, main_with_render,
                       write_noise_image)
-from sphera_common import (extract_features, match_exhaustive, run_colmap,
+from sphera_common import (extract_features, match_exhaustive,
+                           model_to_text, read_text_cameras, run_colmap,
                            run_render)
 
 WIDTH, HEIGHT = 640, 480
@@ -112,6 +116,83 @@ class MapperReportTest(TempDirTestCase):
         for name in ("blank.pgm", "noise1.pgm", "noise2.pgm"):
             self.assertIn(f"{name}: not registered: ", result.stdout)
         self.assertIn("Failed to create any sparse model", result.stdout)
+
+
+class HeldCameraTest(TempDirTestCase):
+    """Nine 195-degree EUCM views of the room, one square-pixel camera that
+    starts at its true intrinsics. The mapper refines fx and fy apart by
+    noise; a bound on fx / fy tighter than that noise must hold the camera
+    at its start, say so in the report, and still reconstruct every view."""
+
+    def map(self, database, images, name, *options):
+        sparse = self.path(name)
+        os.makedirs(sparse)
+        result = run_colmap("mapper", "--database_path", database,
+                            "--image_path", images, "--output_path", sparse,
+                            *options, check=False)
+        return sparse, result
+
+    def final_camera(self, sparse, name):
+        cameras = read_text_cameras(model_to_text(
+            os.path.join(sparse, "0"), self.path(name + "_txt")))
+        self.assertEqual(len(cameras), 1)
+        return next(iter(cameras.values()))
+
+    def test_camera_held_at_its_start_and_reported(self):
+        scene = self.path("scene")
+        run_render(scene, "--layout", "room9", "--model", "EUCM", "--width",
+                   "640", "--height", "640", "--supersample", "2", "--seed",
+                   "4")
+        truth = next(iter(read_text_cameras(
+            os.path.join(scene, "sparse_gt")).values()))
+        model, width, height, params = truth
+        self.assertEqual(model, "EUCM")
+        self.assertEqual(params[0], params[1])
+        images = os.path.join(scene, "images")
+        database = self.path("database.db")
+        extract_features(database, images, "EUCM", params=params)
+        match_exhaustive(database)
+
+        # Unbounded (the default 20%): fx / fy drifts from 1 by noise.
+        sparse, result = self.map(database, images, "free")
+        self.assertEqual(result.returncode, 0, result.stdout[-3000:])
+        self.assertNotIn("was held", result.stdout)
+        free = self.final_camera(sparse, "free")[3]
+        drift = abs(free[0] / free[1] - 1)
+        self.assertGreater(drift, 1e-7)
+
+        sparse, result = self.map(database, images, "held",
+                                  "--Mapper.hold_aspect_change", drift / 10)
+        log = result.stdout
+        self.assertEqual(result.returncode, 0, log[-3000:])
+        self.assertRegex(log, r"Camera 1 \(EUCM\): its self-calibration ran "
+                              r"away: a square-pixel lens ended with fx / fy")
+        self.assertRegex(log, r"Camera 1 \(EUCM\) was held: its "
+                              r"self-calibration ran away \(.*\); it kept ")
+        self.assertIn("Mapper report: 9 of 9 images registered, in 1 model(s)",
+                      log)
+        held = self.final_camera(sparse, "held")[3]
+        self.assertLessEqual(abs(held[0] / held[1] - 1), drift / 10)
+        # The model keeps the camera the report names, as it was held.
+        kept = re.search(r"it kept ([-+0-9.e, ]+?) \(Mapper\.hold_focal_ratio",
+                         log)
+        self.assertIsNotNone(kept, log[-3000:])
+        kept = [float(v) for v in kept[1].split(",")]
+        self.assertEqual(len(kept), len(held))
+        for value, reported in zip(held, kept):
+            self.assertAlmostEqual(value, reported,
+                                   delta=1e-5 * abs(reported) + 1e-9)
+        # It did not run far before being held: within 1% of its start.
+        for value, start in zip(held[:4], params[:4]):
+            self.assertAlmostEqual(value, start, delta=0.01 * start)
+
+        # A bound that holds every camera before it moves is refused, named,
+        # and nothing is written.
+        sparse, result = self.map(database, images, "bad",
+                                  "--Mapper.hold_focal_ratio", 1)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("hold_focal_ratio", result.stdout)
+        self.assertEqual(os.listdir(sparse), [])
 
 
 if __name__ == "__main__":

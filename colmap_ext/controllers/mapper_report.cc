@@ -1,5 +1,7 @@
 #include "colmap_ext/controllers/mapper_report.h"
 
+#include "colmap_ext/scene/intrinsics_divergence.h"
+
 #include <algorithm>
 #include <unordered_map>
 #include <unordered_set>
@@ -101,6 +103,12 @@ void LogMapperReport(const std::vector<MapperImageReport>& report,
     if (entry.model_index < 0) {
       LOG(WARNING) << entry.name << ": not registered: " << entry.reason;
     }
+  }  for (const HeldCamera& held : HeldCameras()) {
+    LOG(WARNING) << "Camera " << held.camera.camera_id << " ("
+                 << held.camera.ModelName()
+                 << ") was held: its self-calibration ran away (" << held.reason
+                 << "); it kept " << held.camera.ParamsToString()
+                 << " (Mapper.hold_focal_ratio, Mapper.hold_aspect_change)";
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <sstream>
 
 namespace colmap {
@@ -59,6 +60,30 @@ std::string IntrinsicsDivergence(const Camera& prior,
     }
   }
   return "";
+}
+
+namespace {
+
+std::mutex& HeldCamerasMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+std::vector<HeldCamera>& HeldCameraList() {
+  static std::vector<HeldCamera> held;
+  return held;
+}
+
+}  // namespace
+
+void RecordHeldCamera(const Camera& camera, const std::string& reason) {
+  const std::lock_guard<std::mutex> lock(HeldCamerasMutex());
+  HeldCameraList().push_back({camera, reason});
+}
+
+std::vector<HeldCamera> HeldCameras() {
+  const std::lock_guard<std::mutex> lock(HeldCamerasMutex());
+  return HeldCameraList();
 }
 
 }  // namespace colmap

@@ -8,6 +8,7 @@
 #include "colmap/scene/camera.h"
 
 #include <string>
+#include <vector>
 
 namespace colmap {
 
@@ -28,5 +29,15 @@ std::string IntrinsicsDivergence(
     const Camera& prior,
     const Camera& refined,
     const IntrinsicsDivergenceOptions& options = IntrinsicsDivergenceOptions());
+
+// The cameras the mappers of this process held, in the order they were held,
+// for the mapper's closing report: the camera as held (id, model, params) and
+// why. Thread-safe.
+struct HeldCamera {
+  Camera camera;
+  std::string reason;
+};
+void RecordHeldCamera(const Camera& camera, const std::string& reason);
+std::vector<HeldCamera> HeldCameras();
 
 }  // namespace colmap
