@@ -520,6 +520,56 @@ class BadOptionTest(BadInputCase):
         self.assertEqual(os.listdir(self.path("out")), [])
 
 
+    def test_undistorters_without_views_are_named_errors(self):
+        """An undistorter that would write a workspace without its views
+        (no registered image, an image list naming none of the model's
+        images, image files missing) names why, exits 1 and writes
+        nothing."""
+        empty_model = self.path("empty_model")
+        os.makedirs(empty_model)
+        with open(os.path.join(empty_model, "cameras.txt"), "w") as f:
+            f.write("1 PINHOLE 320 240 250 250 160 120\n")
+        for name in ("images.txt", "points3D.txt"):
+            open(os.path.join(empty_model, name), "w").close()
+        image_list = self.path("list.txt")
+        with open(image_list, "w") as f:
+            f.write("not_in_the_model.jpg\n")
+        no_images = self.path("no_images")
+        os.makedirs(no_images)
+        cases = [
+            ("image_undistorter, model without images", "image_undistorter",
+             empty_model, Scene.images, [], [empty_model, "no registered"]),
+            ("image_undistorter, list naming no image", "image_undistorter",
+             Scene.model, Scene.images, ["--image_list_path", image_list],
+             [image_list]),
+            ("image_undistorter, image files missing", "image_undistorter",
+             Scene.model, no_images, [], [".jpg not found in " + no_images]),
+            ("sphere_undistorter, model without images", "sphere_undistorter",
+             empty_model, Scene.images, [], ["no registered image"]),
+            ("sphere_undistorter, image files missing", "sphere_undistorter",
+             Scene.model, no_images, [], [".jpg not found in " + no_images]),
+        ]
+        for index, (case, command, model, images, extra, names) in enumerate(
+                cases):
+            out = self.path(f"out{index}")
+            os.makedirs(out)
+            with self.subTest(case=case):
+                code, output = run_bounded(
+                    [command, "--input_path", model, "--image_path", images,
+                     "--output_path", out, *extra])
+                self.assert_named_error(code, output, names, case)
+                self.assertEqual(os.listdir(out), [], case)
+        # The same commands on the intact model write their workspaces.
+        for command in ("image_undistorter", "sphere_undistorter"):
+            out = self.path("valid_" + command)
+            os.makedirs(out)
+            code, output = run_bounded([command, "--input_path", Scene.model,
+                                        "--image_path", Scene.images,
+                                        "--output_path", out])
+            self.assertEqual(code, 0, output[-2000:])
+            self.assertIn("images", os.listdir(out))
+
+
 # ---------------------------------------------------------------------------
 # Killed runs
 

@@ -10,7 +10,9 @@ replaced by random bytes of the same size. Text: each file cut inside a
 line at five places, without its last line, with a value that is not a
 number and one that is not finite. Binary: a camera parameter and a point
 coordinate set to NaN and to infinity. Each case runs through
-`model_analyzer` and `model_converter`.
+`model_analyzer` and `model_converter`; non-finite values in text and binary
+files also through the evaluator, the bundle adjuster and both
+undistorters.
 """
 import hashlib
 import os
@@ -139,9 +141,21 @@ class BadModelTest(TempDirTestCase):
     def run_command(self, command, model, output):
         if command == "model_analyzer":
             args = ["model_analyzer", "--path", model]
-        else:
+        elif command == "model_converter":
             args = ["model_converter", "--input_path", model, "--output_path",
                     output, "--output_type", "TXT"]
+        elif command == "model_evaluator (input)":
+            args = ["model_evaluator", "--gt_path", self.path("binary"),
+                    "--input_path", model, "--output_path", output]
+        elif command == "model_evaluator (ground truth)":
+            args = ["model_evaluator", "--gt_path", model, "--input_path",
+                    self.path("binary"), "--output_path", output]
+        elif command == "bundle_adjuster":
+            args = ["bundle_adjuster", "--input_path", model, "--output_path",
+                    output]
+        else:  # the undistorters
+            args = [command, "--input_path", model, "--image_path",
+                    self.path("images"), "--output_path", output]
         try:
             result = subprocess.run([COLMAP, *args], stdout=subprocess.PIPE,
                                     stderr=subprocess.STDOUT, text=True,
@@ -157,9 +171,9 @@ class BadModelTest(TempDirTestCase):
                                             self.path("out_valid_" + command))
             self.assertEqual(code, 0, output[-2000:])
 
-    def check_named_errors(self, cases):
-        """Runs every command on every damaged model of CASES and checks
-        the outcome; returns the number of runs."""
+    def check_named_errors(self, cases, commands=COMMANDS):
+        """Runs every command of COMMANDS on every damaged model of CASES
+        and checks the outcome; returns the number of runs."""
         runs = 0
         for index, (case, damaged_name, files) in enumerate(cases):
             model = self.path(f"case{index}")
@@ -169,7 +183,7 @@ class BadModelTest(TempDirTestCase):
                     f.write(data)
             before = {name: digest(os.path.join(model, name))
                       for name in files}
-            for command in COMMANDS:
+            for command in commands:
                 output_dir = self.path(f"out{index}_{command}")
                 os.makedirs(output_dir)
                 with self.subTest(case=case, command=command):
@@ -231,6 +245,48 @@ class BadModelTest(TempDirTestCase):
             cases.append((f"{name} not finite at {offset}", name, files))
         runs = self.check_named_errors(cases)
         self.assertEqual(runs, 4 * len(COMMANDS))
+
+    def test_non_finite_values_stop_every_command_that_reads_models(self):
+        """NaN and infinity in a camera, a pose or a point, in text and in
+        binary files, are refused where they enter: by every command that
+        reads a model (the evaluator on either side, the bundle adjuster,
+        both undistorters), not written into their outputs."""
+        os.makedirs(self.path("images"))
+        nan = struct.pack("<d", float("nan"))
+        cases = []
+        # Binary: a camera parameter, a point coordinate, an image's
+        # quaternion (images.bin: count (8), image_id (4), then qw; unused
+        # when frames.bin holds the poses) and a frame's translation
+        # (frames.bin: count (8), frame_id (4), rig_id (4), qw qx qy qz, tx).
+        for name, offset in (("cameras.bin", 32), ("points3D.bin", 16),
+                             ("images.bin", 12), ("frames.bin", 48)):
+            data = self.valid[name]
+            files = dict(self.valid)
+            files[name] = data[:offset] + nan + data[offset + 8:]
+            cases.append((f"{name} NaN at {offset}", name, files))
+        # Text: the third value of the first line of each file set to inf.
+        valid = {}
+        for stem in MODEL_FILES:
+            with open(self.path("text_full", stem + ".txt"), "rb") as f:
+                valid[stem + ".txt"] = f.read()
+        for stem in ("cameras", "images", "points3D"):
+            name = stem + ".txt"
+            lines = valid[name].split(b"\n")
+            first = next(i for i, line in enumerate(lines)
+                         if line and not line.startswith(b"#"))
+            tokens = lines[first].split(b" ")
+            tokens[4 if stem == "cameras" else 2] = b"inf"
+            files = dict(valid)
+            files[name] = b"\n".join(lines[:first] + [b" ".join(tokens)] +
+                                     lines[first + 1:])
+            cases.append((f"{name} inf in line {first + 1}", name, files))
+        commands = ("model_evaluator (input)", "model_evaluator (ground truth)",
+                    "bundle_adjuster", "image_undistorter",
+                    "sphere_undistorter")
+        runs = self.check_named_errors(cases, commands)
+        self.assertEqual(runs, 7 * len(commands))
+        print(f"{runs} runs of model-reading commands on non-finite values, "
+              "all named errors")
 
 
 if __name__ == "__main__":

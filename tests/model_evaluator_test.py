@@ -324,6 +324,27 @@ class StrechaImporterTest(TempDirTestCase):
         self.assertNotEqual(result.returncode, 0)
         self.assertIn("bad.jpg.camera:2", result.stdout)
 
+    def test_non_finite_values_are_named(self):
+        # A NaN focal length, an infinite rotation entry, a NaN centre: each
+        # names its file and line, and nothing is written.
+        valid = ["1000 0 500", "0 1100 400", "0 0 1", "0 0 0", "0 -1 0",
+                 "1 0 0", "0 0 1", "1 2 3", "1000 800"]
+        for line, value in ((0, "nan 0 500"), (5, "1 inf 0"),
+                            (7, "1 nan 3")):
+            with self.subTest(line=line + 1):
+                shutil.rmtree(self.path("cams"), ignore_errors=True)
+                lines = list(valid)
+                lines[line] = value
+                self.write_camera("c.jpg", "\n".join(lines) + "\n")
+                os.makedirs(self.path(f"model{line}"))
+                result = run_colmap("strecha_importer", "--input_path",
+                                    self.path("cams"), "--output_path",
+                                    self.path(f"model{line}"), check=False)
+                self.assertNotEqual(result.returncode, 0)
+                self.assertIn(f"c.jpg.camera:{line + 1}", result.stdout)
+                self.assertIn("finite", result.stdout)
+                self.assertEqual(os.listdir(self.path(f"model{line}")), [])
+
     @unittest.skipUnless(os.path.isdir(FOUNTAIN), "needs ../shared/data")
     def test_fountain_ground_truth_imports(self):
         import_fountain(self.path("model"))

@@ -4,6 +4,8 @@
 #include "colmap/util/string.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -23,22 +25,30 @@ std::vector<double> ReadNumbers(std::istream& file,
     if (line.empty()) {
       continue;
     }
+    // strtod, unlike operator>>, reads "nan" and "inf": they are named as
+    // such rather than as a short line.
     std::istringstream stream(line);
     std::vector<double> numbers;
-    double value;
-    while (stream >> value) {
+    std::string token;
+    while (stream >> token) {
+      char* end = nullptr;
+      const double value = std::strtod(token.c_str(), &end);
+      if (end == token.c_str() || *end != '\0') {
+        throw std::invalid_argument(StringPrintf(
+            "%s:%d: '%s' is not a number", path.c_str(), *line_number,
+            token.c_str()));
+      }
+      if (!std::isfinite(value)) {
+        throw std::invalid_argument(StringPrintf(
+            "%s:%d: '%s' is not a finite number", path.c_str(), *line_number,
+            token.c_str()));
+      }
       numbers.push_back(value);
     }
-    if (numbers.size() != count || !stream.eof()) {
+    if (numbers.size() != count) {
       throw std::invalid_argument(StringPrintf(
           "%s:%d: expected %d numbers", path.c_str(), *line_number,
           static_cast<int>(count)));
-    }
-    for (const double number : numbers) {
-      if (!std::isfinite(number)) {
-        throw std::invalid_argument(StringPrintf(
-            "%s:%d: non-finite number", path.c_str(), *line_number));
-      }
     }
     return numbers;
   }
