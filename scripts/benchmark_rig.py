@@ -31,6 +31,7 @@ recovered sensor_from_rig of every lens is compared with the truth
 Usage (from the repository root, after scripts/build.sh):
   scripts/benchmark_rig.py                        3 seeds, both presets
   scripts/benchmark_rig.py --repeats 1 --presets dual_fisheye --frames 10
+  scripts/benchmark_rig.py --first_seed 1 --repeats 2 ...   adds seeds 1, 2
 Output (--output, default build/bench_rig): rig_runs.csv (every run),
 rig_results.csv (median and min..max per preset and system, ratios to the
 rig), rig_results.png, logs/.
@@ -335,6 +336,9 @@ def main():
         description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     parser.add_argument("--repeats", type=int, default=3,
                         help="seeds 0..N-1: each renders its own scene")
+    parser.add_argument("--first_seed", type=int, default=0,
+                        help="seeds first_seed .. first_seed + repeats - 1 "
+                             "(to add seeds to an earlier output)")
     parser.add_argument("--presets", default="dual_fisheye,ring8")
     parser.add_argument("--systems",
                         default="rig,stitched,stitched_upstream,one_lens")
@@ -366,6 +370,7 @@ def main():
         if not os.path.exists(path):
             sys.exit(f"benchmark_rig: {path} is missing (scripts/build.sh)")
     os.makedirs(args.output, exist_ok=True)
+    seeds = range(args.first_seed, args.first_seed + args.repeats)
     # model_to_text and friends run this colmap.
     common.COLMAP = args.colmap
     # Runs of an earlier call into the same output that this one does not
@@ -378,9 +383,9 @@ def main():
                     for row in csv.DictReader(f)]
         runs = [row for row in runs
                 if row.get("system") not in systems
-                or int(row.get("seed", -1)) >= args.repeats
+                or int(row.get("seed", -1)) not in seeds
                 or row.get("preset") not in args.presets.split(",")]
-    for seed in range(args.repeats):
+    for seed in seeds:
         for preset in args.presets.split(","):
             scene = os.path.join(args.output, f"scene_{preset}_{seed}")
             if not os.path.exists(os.path.join(scene, "sparse_gt")):
