@@ -103,7 +103,8 @@ void LogMapperReport(const std::vector<MapperImageReport>& report,
     if (entry.model_index < 0) {
       LOG(WARNING) << entry.name << ": not registered: " << entry.reason;
     }
-  }  for (const HeldCamera& held : HeldCameras()) {
+  }
+  for (const HeldCamera& held : TakeHeldCameras()) {
     LOG(WARNING) << "Camera " << held.camera.camera_id << " ("
                  << held.camera.ModelName()
                  << ") was held: its self-calibration ran away (" << held.reason

@@ -81,9 +81,11 @@ void RecordHeldCamera(const Camera& camera, const std::string& reason) {
   HeldCameraList().push_back({camera, reason});
 }
 
-std::vector<HeldCamera> HeldCameras() {
+std::vector<HeldCamera> TakeHeldCameras() {
   const std::lock_guard<std::mutex> lock(HeldCamerasMutex());
-  return HeldCameraList();
+  std::vector<HeldCamera> held;
+  held.swap(HeldCameraList());
+  return held;
 }
 
 }  // namespace colmap

@@ -30,14 +30,14 @@ std::string IntrinsicsDivergence(
     const Camera& refined,
     const IntrinsicsDivergenceOptions& options = IntrinsicsDivergenceOptions());
 
-// The cameras the mappers of this process held, in the order they were held,
-// for the mapper's closing report: the camera as held (id, model, params) and
-// why. Thread-safe.
+// The cameras the mappers of this process held since the last
+// TakeHeldCameras(), in the order they were held, for the mapper's closing
+// report: the camera as held (id, model, params) and why. Thread-safe.
 struct HeldCamera {
   Camera camera;
   std::string reason;
 };
 void RecordHeldCamera(const Camera& camera, const std::string& reason);
-std::vector<HeldCamera> HeldCameras();
+std::vector<HeldCamera> TakeHeldCameras();
 
 }  // namespace colmap
