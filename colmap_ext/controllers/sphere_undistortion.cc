@@ -646,7 +646,6 @@ SphereExportSummary ExportPerspectiveWorkspace(
     throw std::invalid_argument("the reconstruction has no registered image");
   }
   const fs::path image_dir(image_path);
-  std::vector<std::string> missing;
   std::map<std::string, std::string> view_sources;
   std::unordered_map<image_t, std::vector<View>> planned;
   for (const image_t image_id : image_ids) {
@@ -657,10 +656,6 @@ SphereExportSummary ExportPerspectiveWorkspace(
       throw std::invalid_argument("image " + image.Name() + ": camera " +
                                   std::to_string(camera.camera_id) + ": " +
                                   params_error);
-    }
-    std::error_code error;
-    if (!fs::is_regular_file(image_dir / image.Name(), error)) {
-      missing.push_back(image.Name());
     }
     std::vector<View> views = PlanViews(image, camera, options, parsed);
     for (const View& view : views) {
@@ -673,13 +668,10 @@ SphereExportSummary ExportPerspectiveWorkspace(
     }
     planned.emplace(image_id, std::move(views));
   }
+  const std::string missing =
+      MissingImageFiles(reconstruction, image_ids, image_path);
   if (!missing.empty()) {
-    std::ostringstream message;
-    message << "image " << missing.front() << " not found in " << image_path;
-    if (missing.size() > 1) {
-      message << " (and " << missing.size() - 1 << " more missing images)";
-    }
-    throw std::invalid_argument(message.str());
+    throw std::invalid_argument(missing);
   }
 
   // Temporary workspace beside the output, moved into place at the end.
@@ -912,6 +904,28 @@ SphereExportSummary ExportPerspectiveWorkspace(
   remover.Release();
   summary.seconds = timer.ElapsedSeconds();
   return summary;
+}
+
+std::string MissingImageFiles(const Reconstruction& reconstruction,
+                              const std::vector<image_t>& image_ids,
+                              const std::string& image_path) {
+  std::vector<std::string> missing;
+  for (const image_t image_id : image_ids) {
+    const std::string& name = reconstruction.Image(image_id).Name();
+    std::error_code error;
+    if (!fs::is_regular_file(fs::path(image_path) / name, error)) {
+      missing.push_back(name);
+    }
+  }
+  if (missing.empty()) {
+    return "";
+  }
+  std::ostringstream message;
+  message << "image " << missing.front() << " not found in " << image_path;
+  if (missing.size() > 1) {
+    message << " (and " << missing.size() - 1 << " more missing images)";
+  }
+  return message.str();
 }
 
 }  // namespace colmap

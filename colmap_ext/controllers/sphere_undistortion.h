@@ -179,4 +179,11 @@ SphereExportSummary ExportPerspectiveWorkspace(
     const std::string& output_path,
     const SphereUndistorterOptions& options);
 
+// "image NAME not found in IMAGE_PATH (and N more missing images)" for the
+// first of `image_ids` whose file is not under `image_path`; empty when every
+// file is there. Used by both undistorters before they write anything.
+std::string MissingImageFiles(const Reconstruction& reconstruction,
+                              const std::vector<image_t>& image_ids,
+                              const std::string& image_path);
+
 }  // namespace colmap
