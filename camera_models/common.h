@@ -69,6 +69,25 @@ void DistortRadTan(const T* k, const T& u, const T& v, T* ud, T* vd,
   }
 }
 
+// One Newton step of the inversion of DistortRadTan at (u, v) towards the
+// distorted point (ud, vd): the step to subtract. False where the map's
+// Jacobian is singular or not finite.
+template <typename T>
+bool RadTanNewtonStep(const T* k, const T& u, const T& v, const T& ud,
+                      const T& vd, T* step_u, T* step_v) {
+  T du, dv, J[4];
+  DistortRadTan(k, u, v, &du, &dv, J);
+  const T det = J[0] * J[3] - J[1] * J[2];
+  if (!(ScalarPart(det) != 0.0) || !std::isfinite(ScalarPart(det))) {
+    return false;
+  }
+  const T res_u = du - ud;
+  const T res_v = dv - vd;
+  *step_u = (J[3] * res_u - J[1] * res_v) / det;
+  *step_v = (J[0] * res_v - J[2] * res_u) / det;
+  return true;
+}
+
 // Inverts DistortRadTan by Newton's method on the 2D map, starting at the
 // distorted point. Stops when the step is below 1e-14 relative to |(u, v)|.
 // False if the iteration does not converge (distortion not invertible there).
@@ -79,14 +98,10 @@ inline bool UndistortRadTanScalar(const double* k, double ud, double vd,
   double cur_u = ud;
   double cur_v = vd;
   for (int i = 0; i < kMaxIterations; ++i) {
-    double du, dv, J[4];
-    DistortRadTan(k, cur_u, cur_v, &du, &dv, J);
-    const double res_u = du - ud;
-    const double res_v = dv - vd;
-    const double det = J[0] * J[3] - J[1] * J[2];
-    if (!(det != 0.0) || !std::isfinite(det)) return false;
-    const double step_u = (J[3] * res_u - J[1] * res_v) / det;
-    const double step_v = (J[0] * res_v - J[2] * res_u) / det;
+    double step_u, step_v;
+    if (!RadTanNewtonStep(k, cur_u, cur_v, ud, vd, &step_u, &step_v)) {
+      return false;
+    }
     cur_u -= step_u;
     cur_v -= step_v;
     const double step2 = step_u * step_u + step_v * step_v;
@@ -130,16 +145,12 @@ bool UndistortRadTan(const T* k, const T& ud, const T& vd, T* u, T* v) {
     }
     const T root_u(u_value);
     const T root_v(v_value);
-    T du, dv, J[4];
-    DistortRadTan(k, root_u, root_v, &du, &dv, J);
-    const T det = J[0] * J[3] - J[1] * J[2];
-    if (!(ScalarPart(det) != 0.0) || !std::isfinite(ScalarPart(det))) {
+    T step_u, step_v;
+    if (!RadTanNewtonStep(k, root_u, root_v, ud, vd, &step_u, &step_v)) {
       return false;
     }
-    const T res_u = du - ud;
-    const T res_v = dv - vd;
-    *u = root_u - (J[3] * res_u - J[1] * res_v) / det;
-    *v = root_v - (J[0] * res_v - J[2] * res_u) / det;
+    *u = root_u - step_u;
+    *v = root_v - step_v;
     return true;
   }
 }
