@@ -74,24 +74,10 @@ def frame_of(name):
 
 def frame_poses(model_path, system, num_lenses):
     """{frame: (R of lens 0 or the panorama, position)} of a text model."""
-    import numpy as np
     poses = common.text_model_poses(model_path)
-    frames = {}
-    for name, (rotation, centre) in poses.items():
-        frames.setdefault(frame_of(name), {})[name.split("/")[0]
-                                              if "/" in name else ""] = (
-            rotation, centre)
-    result = {}
-    for frame, lenses in frames.items():
-        if system == "rig":
-            if len(lenses) != num_lenses or "lens0" not in lenses:
-                continue  # a frame is registered with all its lenses
-            position = np.mean([c for _, c in lenses.values()], axis=0)
-            result[frame] = (lenses["lens0"][0], position)
-        else:
-            (rotation, centre), = lenses.values()
-            result[frame] = (rotation, centre)
-    return result
+    if system == "rig":
+        return common.rig_frame_poses(poses, num_lenses)
+    return {frame_of(name): pose for name, pose in poses.items()}
 
 
 def rough_rig_config(scene, path):
@@ -99,10 +85,7 @@ def rough_rig_config(scene, path):
     what a user knows of a camera (lens directions), not its calibration."""
     import json
     with open(os.path.join(scene, "rig_config.json")) as f:
-        config = json.load(f)
-    for camera in config[0]["cameras"]:
-        if not camera.get("ref_sensor"):
-            camera["cam_from_rig_translation"] = [0, 0, 0]
+        config = common.without_rig_offsets(json.load(f))
     with open(path, "w") as f:
         json.dump(config, f, indent=1)
 

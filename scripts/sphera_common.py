@@ -319,6 +319,32 @@ def sensors_by_folder(path):
     return sensors
 
 
+def rig_frame_poses(poses, num_lenses):
+    """{frame: (R cam_from_world of lens0, mean of the lens centres)} of the
+    poses {'lensK/NAME': (R, centre)} of a rig model (text_model_poses), for
+    the frames that hold all NUM_LENSES lenses."""
+    import numpy as np
+    lenses = {}
+    for name, pose in poses.items():
+        lens, frame = name.split("/")[0], name.split("/")[-1]
+        lenses.setdefault(frame, {})[lens] = pose
+    return {frame: (of_frame["lens0"][0],
+                    np.mean([c for _, c in of_frame.values()], axis=0))
+            for frame, of_frame in lenses.items()
+            if len(of_frame) == num_lenses and "lens0" in of_frame}
+
+
+def without_rig_offsets(config):
+    """CONFIG (a rig_config.json list) with every non-reference lens's
+    translation set to zero: what a user knows of a camera (the lenses'
+    directions), not its calibration."""
+    for rig in config:
+        for camera in rig["cameras"]:
+            if not camera.get("ref_sensor"):
+                camera["cam_from_rig_translation"] = [0, 0, 0]
+    return config
+
+
 def rig_errors(gt_path, model_path):
     """{image folder: (rotation error in degrees, centre error)} of the
     sensor_from_rig poses of the text model at MODEL_PATH against those of

@@ -134,9 +134,12 @@ class BadModelTest(TempDirTestCase):
                    "--output_path", self.path("text_full"), "--output_type",
                    "TXT")
         self.valid = {}
+        self.valid_text = {}
         for stem in MODEL_FILES:
             with open(self.path("binary", stem + ".bin"), "rb") as f:
                 self.valid[stem + ".bin"] = f.read()
+            with open(self.path("text_full", stem + ".txt"), "rb") as f:
+                self.valid_text[stem + ".txt"] = f.read()
 
     def run_command(self, command, model, output):
         if command == "model_analyzer":
@@ -219,11 +222,7 @@ class BadModelTest(TempDirTestCase):
         print(f"{runs} runs on damaged binary models, all named errors")
 
     def test_damaged_text_files_are_named_errors(self):
-        valid = {}
-        for stem in MODEL_FILES:
-            with open(self.path("text_full", stem + ".txt"), "rb") as f:
-                valid[stem + ".txt"] = f.read()
-        cases = damaged_models(valid, ".txt", text_damages)
+        cases = damaged_models(self.valid_text, ".txt", text_damages)
         self.assertEqual(len(cases), 5 * 8)
         runs = self.check_named_errors(cases)
         self.assertEqual(runs, 5 * 8 * len(COMMANDS))
@@ -264,19 +263,16 @@ class BadModelTest(TempDirTestCase):
             files = dict(self.valid)
             files[name] = data[:offset] + nan + data[offset + 8:]
             cases.append((f"{name} NaN at {offset}", name, files))
-        # Text: the third value of the first line of each file set to inf.
-        valid = {}
-        for stem in MODEL_FILES:
-            with open(self.path("text_full", stem + ".txt"), "rb") as f:
-                valid[stem + ".txt"] = f.read()
+        # Text: in the first data line of each file, the first camera
+        # parameter, an image's qx or a point's y set to inf.
         for stem in ("cameras", "images", "points3D"):
             name = stem + ".txt"
-            lines = valid[name].split(b"\n")
+            lines = self.valid_text[name].split(b"\n")
             first = next(i for i, line in enumerate(lines)
                          if line and not line.startswith(b"#"))
             tokens = lines[first].split(b" ")
             tokens[4 if stem == "cameras" else 2] = b"inf"
-            files = dict(valid)
+            files = dict(self.valid_text)
             files[name] = b"\n".join(lines[:first] + [b" ".join(tokens)] +
                                      lines[first + 1:])
             cases.append((f"{name} inf in line {first + 1}", name, files))

@@ -14,24 +14,11 @@ from cli_util import TempDirTestCase, main_with_render
 from sphera_common import (aligned_pose_errors, extract_features,
                            match_exhaustive, median, model_to_text,
                            pose_errors, read_text_images, rig_errors,
-                           run_colmap, run_render, text_model_poses)
+                           rig_frame_poses, run_colmap, run_render,
+                           text_model_poses, without_rig_offsets)
 
 FRAMES = 6
 LENSES = 8
-
-
-def frame_poses(poses):
-    """{frame: (R cam_from_world of lens 0, mean of the lens centres)} of
-    the poses {'lensK/NAME': (R, centre)} of a model."""
-    import numpy as np
-    lenses = {}
-    for name, pose in poses.items():
-        lens, frame = name.split("/")
-        lenses.setdefault(frame, {})[lens] = pose
-    return {frame: (poses_of["lens0"][0],
-                    np.mean([c for _, c in poses_of.values()], axis=0))
-            for frame, poses_of in lenses.items()
-            if len(poses_of) == LENSES}
 
 
 class RingRigTest(TempDirTestCase):
@@ -50,11 +37,8 @@ class RingRigTest(TempDirTestCase):
         # What a user knows: the lenses' directions and intrinsics; every
         # lens centre starts at the reference lens's.
         with open(os.path.join(scene, "rig_config.json")) as f:
-            config = json.load(f)
+            config = without_rig_offsets(json.load(f))
         self.assertEqual(len(config[0]["cameras"]), LENSES)
-        for camera in config[0]["cameras"]:
-            if not camera.get("ref_sensor"):
-                camera["cam_from_rig_translation"] = [0, 0, 0]
         config_path = self.path("rig_config.json")
         with open(config_path, "w") as f:
             json.dump(config, f)
@@ -72,8 +56,8 @@ class RingRigTest(TempDirTestCase):
         gt = os.path.join(scene, "sparse_gt")
         # Per frame: lens 0's orientation and the mean of the lens centres
         # (a lens centre's error in the rig is checked below on its own).
-        gt_frames = frame_poses(text_model_poses(gt))
-        frames = frame_poses(text_model_poses(self.path("text")))
+        gt_frames = rig_frame_poses(text_model_poses(gt), LENSES)
+        frames = rig_frame_poses(text_model_poses(self.path("text")), LENSES)
         self.assertEqual(sorted(frames), sorted(gt_frames))
         positions = [e[1] for e in
                      aligned_pose_errors(gt_frames, frames).values()]
