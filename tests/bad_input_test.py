@@ -18,6 +18,7 @@ import random
 import shutil
 import signal
 import sqlite3
+import struct
 import subprocess
 import tempfile
 import time
@@ -568,6 +569,125 @@ class BadOptionTest(BadInputCase):
                                         "--output_path", out])
             self.assertEqual(code, 0, output[-2000:])
             self.assertIn("images", os.listdir(out))
+
+
+# ---------------------------------------------------------------------------
+# Matching that verifies no pair
+
+
+# An EUCM camera whose beta shrinks its image circle to a few pixels: a
+# valid camera of the wrong lens, under which no pair can be verified.
+BROKEN_EUCM = ["--ImageReader.camera_model", "EUCM", "--ImageReader.camera_params",
+               "20,20,160,120,1,100", "--ImageReader.single_camera", "1"]
+TIGHT = ["--TwoViewGeometry.max_error", "1e-6"]  # no RANSAC fit has inliers
+
+
+def verified_pairs(database):
+    """(pairs with raw matches, pairs with a verified two-view geometry)."""
+    connection = sqlite3.connect(f"file:{database}?mode=ro", uri=True)
+    try:
+        return tuple(connection.execute(query).fetchone()[0] for query in (
+            "SELECT count(*) FROM matches WHERE rows > 0",
+            "SELECT count(*) FROM two_view_geometries WHERE rows > 0 AND "
+            "config >= 2"))
+    finally:
+        connection.close()
+
+
+class UnverifiedMatchingTest(BadInputCase):
+    """A matching run after which the database holds no verified pair (a
+    wrong camera, nothing in common, a pairing that selects nothing) says
+    why and exits 1; the matches it found stay in the database."""
+
+    def test_matching_that_verifies_nothing_is_a_named_error(self):
+        broken = self.path("broken.db")
+        run_colmap("feature_extractor", "--database_path", broken,
+                   "--image_path", Scene.images, *BROKEN_EUCM, *CPU)
+        one = self.path("one")
+        os.makedirs(one)
+        shutil.copy(os.path.join(Scene.images, sorted(os.listdir(
+            Scene.images))[0]), one)
+        single = self.path("single.db")
+        run_colmap("feature_extractor", "--database_path", single,
+                   "--image_path", one, *CPU)
+        pair_list = self.path("pairs.txt")
+        names = sorted(os.listdir(Scene.images))
+        with open(pair_list, "w") as f:
+            for a, b in zip(names, names[1:]):
+                f.write(f"{a} {b}\n")
+        all_pairs = NUM_IMAGES * (NUM_IMAGES - 1) // 2
+        # (case, source database, arguments, names in the error, pairs with
+        # raw matches afterwards)
+        cases = [
+            ("exhaustive, broken camera", broken,
+             ["exhaustive_matcher", *CPU_MATCHING],
+             ["camera 1 (EUCM) lifts only", "yet no two-view geometry fits"],
+             None),
+            ("sequential, no fit", Scene.extracted,
+             ["sequential_matcher", *CPU_MATCHING, *TIGHT],
+             ["yet no two-view geometry fits"], None),
+            ("imported pairs, no fit", Scene.extracted,
+             ["matches_importer", "--match_list_path", pair_list,
+              "--match_type", "pairs", *CPU_MATCHING, *TIGHT],
+             ["yet no two-view geometry fits"], None),
+            ("exhaustive, too few matches", Scene.extracted,
+             ["exhaustive_matcher", *CPU_MATCHING,
+              "--TwoViewGeometry.min_num_inliers", "100000"],
+             ["none has the 100000 raw matches"], 0),
+            ("spatial, no position priors", Scene.extracted,
+             ["spatial_matcher", *CPU_MATCHING],
+             ["selected none of the 16 images' pairs", "here 0"], 0),
+            ("exhaustive, one image", single,
+             ["exhaustive_matcher", *CPU_MATCHING],
+             ["holds 1 image(s)"], 0),
+        ]
+        for index, (case, source, args, reasons, raw) in enumerate(cases):
+            database = self.path(f"match{index}.db")
+            shutil.copy(source, database)
+            with self.subTest(case=case):
+                code, output = run_bounded(
+                    [args[0], "--database_path", database, *args[1:]])
+                self.assert_named_error(
+                    code, output, [database, *reasons], case)
+                if "camera 1" not in reasons[0]:
+                    self.assertNotIn("lifts only", output, case)
+                matched, verified = verified_pairs(database)
+                self.assertEqual(verified, 0, case)
+                if raw is None:  # the matches found are kept
+                    self.assertGreater(matched, 0, case)
+                else:
+                    self.assertEqual(matched, raw, case)
+                if index == 0:  # the counts it gives are the database's
+                    self.assertRegex(output, f"of {all_pairs} pairs matched, "
+                                     f"{matched} ha(s|ve) at least 15 raw "
+                                     "matches")
+        # geometric_verifier on the broken camera's kept matches: the same
+        # error; with the camera right, the same matches verify (exit 0).
+        for case, params in (("broken camera", None),
+                             ("camera corrected", "160,160,160,120,0,1")):
+            database = self.path(case.replace(" ", "_") + ".db")
+            shutil.copy(self.path("match0.db"), database)
+            connection = sqlite3.connect(database)
+            connection.execute("DELETE FROM two_view_geometries")
+            if params:
+                connection.execute(
+                    "UPDATE cameras SET params = ?", (struct.pack(
+                        "6d", *map(float, params.split(","))),))
+            connection.commit()
+            connection.close()
+            with self.subTest(case="geometric_verifier, " + case):
+                code, output = run_bounded(
+                    ["geometric_verifier", "--database_path", database])
+                if params:
+                    self.assertEqual(code, 0, output[-2000:])
+                    self.assertGreater(verified_pairs(database)[1], 0)
+                else:
+                    self.assert_named_error(
+                        code, output, [database, "camera 1 (EUCM) lifts only"],
+                        case)
+        # Valid matching still succeeds: the scene's database was matched
+        # with check=True in setUpModule, and holds verified pairs.
+        self.assertGreater(verified_pairs(Scene.database)[1], 0)
 
 
 # ---------------------------------------------------------------------------

@@ -108,7 +108,19 @@ class MapperReportTest(TempDirTestCase):
         for seed in (1, 2):
             write_noise_image(os.path.join(images, f"noise{seed}.pgm"), WIDTH,
                               HEIGHT, seed=seed)
-        database = self.extract_and_match(images)
+        database = self.path("database.db")
+        extract_features(database, images, "PINHOLE",
+                         params=[320, 320, 320, 240])
+        # The matcher already says there is nothing to map, and fails.
+        matching = match_exhaustive(
+            database, program=lambda *args: run_colmap(*args, check=False))
+        self.assertEqual(matching.returncode, 1, matching.stdout[-2000:])
+        self.assertRegex(matching.stdout,
+                         "no image pair passed geometric verification: of 3 "
+                         "pairs matched, (none has the 15 raw matches|"
+                         r"\d ha(s|ve) at least 15 raw matches, yet no "
+                         "two-view geometry fits any: the images may show "
+                         "different scenes)")
         result = self.run_mapper(database, images)
         self.assertNotEqual(result.returncode, 0)
         self.assertIn("Mapper report: 0 of 3 images registered, in 0 model(s)",

@@ -483,6 +483,54 @@ bool HoldsDatabase(const std::filesystem::path& path) {
          std::filesystem::file_size(path, error) > 0 && !error;
 }
 
+// ": camera C (MODEL) lifts only P% of its image to rays, ..." for the
+// cameras of images whose parameters turn fewer than half of a grid of
+// pixels into viewing rays (an image circle or field of view far from the
+// lens's), or empty.
+std::string CamerasLiftingLittle(const ReadOnlyDatabase& db) {
+  std::string cameras;
+  db.Query(
+      "SELECT camera_id, model, width, height, params FROM cameras WHERE "
+      "camera_id IN (SELECT camera_id FROM images)",
+      [&cameras](sqlite3_stmt* stmt) {
+        const CameraModelId model_id =
+            static_cast<CameraModelId>(Int(stmt, 1));
+        if (!ExistsCameraModelWithId(model_id)) {
+          return;
+        }
+        const size_t num_params = CameraModelNumParams(model_id);
+        const double width = Int(stmt, 2);
+        const double height = Int(stmt, 3);
+        if (num_params == 0 ||
+            Bytes(stmt, 4) !=
+                static_cast<int64_t>(num_params * sizeof(double))) {
+          return;
+        }
+        std::vector<double> params(num_params);
+        std::memcpy(params.data(), sqlite3_column_blob(stmt, 4),
+                    num_params * sizeof(double));
+        constexpr int kGrid = 20;
+        int lifted = 0;
+        for (int i = 0; i < kGrid; ++i) {
+          for (int j = 0; j < kGrid; ++j) {
+            const Eigen::Vector2d pixel((i + 0.5) * width / kGrid,
+                                        (j + 0.5) * height / kGrid);
+            if (CameraModelCamRayFromImg(model_id, params, pixel)) {
+              ++lifted;
+            }
+          }
+        }
+        const int percent = 100 * lifted / (kGrid * kGrid);
+        if (percent < 50) {
+          cameras += (cameras.empty() ? ": camera " : ", camera ") +
+                     Str(Int(stmt, 0)) + " (" +
+                     CameraModelIdToName(model_id) + ") lifts only " +
+                     Str(percent) + "% of its image to rays";
+        }
+      });
+  return cameras;
+}
+
 }  // namespace
 
 std::string MissingDatabaseError(const std::string& command, int argc,
@@ -600,6 +648,69 @@ std::string MissingPaths(int argc, const char* const* argv) {
                option + " " + value;
   }
   return missing;
+}
+
+std::string NoVerifiedPairError(const std::filesystem::path& path,
+                                const int min_num_inliers) {
+  if (!HoldsDatabase(path)) {
+    return "";
+  }
+  const ReadOnlyDatabase db(path);
+  const auto count = [&db](const std::string& sql) {
+    int64_t n = 0;
+    db.Query(sql, [&n](sqlite3_stmt* stmt) { n = Int(stmt, 0); });
+    return n;
+  };
+  const std::string name = "database " + path.string() + ": ";
+  if (count("SELECT count(*) FROM two_view_geometries WHERE rows > 0 AND "
+            "config >= 2") > 0) {
+    return "";
+  }
+  const int64_t num_images = count("SELECT count(*) FROM images");
+  if (num_images < 2) {
+    return name + "holds " + Str(num_images) +
+           " image(s): there is no image pair to match";
+  }
+  const int64_t num_pairs = count(
+      "SELECT count(*) FROM (SELECT pair_id FROM matches UNION "
+      "SELECT pair_id FROM two_view_geometries)");
+  if (num_pairs == 0) {
+    int64_t num_priors = 0;
+    if (count("SELECT count(*) FROM sqlite_master WHERE type = 'table' AND "
+              "name = 'pose_priors'") > 0) {
+      num_priors = count("SELECT count(*) FROM pose_priors WHERE position "
+                         "IS NOT NULL");
+    }
+    return name + "no image pair was matched: the pairing selected none of "
+                  "the " + Str(num_images) + " images' pairs (spatial_matcher "
+                  "pairs images with position priors, here " +
+           Str(num_priors) + "; transitive_matcher extends matched pairs)";
+  }
+  const std::string threshold = Str(std::max(min_num_inliers, 1));
+  const int64_t num_enough =
+      count("SELECT count(*) FROM matches WHERE rows >= " + threshold);
+  const int64_t most = count("SELECT coalesce(max(rows), 0) FROM matches");
+  std::string why;
+  if (num_enough > 0) {
+    const std::string cameras = CamerasLiftingLittle(db);
+    why = Str(num_enough) + (num_enough == 1 ? " has" : " have") +
+          " at least " + threshold +
+          " raw matches, yet no two-view geometry fits any" +
+          (cameras.empty()
+               ? ": the images may show different scenes, or a camera's "
+                 "model or parameters are wrong (a wrong camera makes every "
+                 "pair fail)."
+               : ". Check the cameras' models and parameters" + cameras +
+                     ".");
+  } else {
+    why = "none has the " + threshold +
+          " raw matches a two-view geometry needs" +
+          (most > 0 ? " (the most: " + Str(most) + ")" : "") +
+          ": the images may not overlap or have too few features.";
+  }
+  return name + "no image pair passed geometric verification: of " +
+         Str(num_pairs) + " pairs matched, " + why +
+         " A mapper has nothing to start from; the matches are kept.";
 }
 
 void CheckDatabaseFile(const std::filesystem::path& path,

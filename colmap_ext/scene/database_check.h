@@ -46,6 +46,15 @@ std::string MissingDatabaseError(const std::string& command, int argc,
 int RemoveUnusedCameras(const std::filesystem::path& path,
                         int64_t keep_camera_id);
 
+// Empty, or why the matching that just wrote to the database at `path`
+// leaves it with no image pair a mapper can use (no two-view geometry
+// with inlier matches): fewer than two images, no pair selected, pairs
+// whose raw matches all fell short of `min_num_inliers`, or pairs with
+// enough raw matches that all failed geometric verification (the sign of
+// a wrong camera model or parameters). The file is only read.
+std::string NoVerifiedPairError(const std::filesystem::path& path,
+                                int min_num_inliers);
+
 // Empty, or "paths that do not exist: --OPTION PATH, ..." for the options
 // of ARGS named *_path whose value is not in the file system (said after a
 // command failed, whichever path made it fail).
