@@ -273,13 +273,18 @@ class DualFisheyeRigTest(TempDirTestCase):
         lenses, _ = self.calibration(self.path("sparse", "0"))
         for name, lens in lenses.items():
             # The lens projects as the true one to a fraction of a pixel
-            # over its image circle (UNIFIED_OMNI's focal length and xi
-            # trade off, so its parameters need not match one by one).
+            # over its image circle.
             self.assertLess(lens["projection_max_px"], 0.5, name)
             self.assertLess(lens["rotation_error_deg"], 0.02, name)
             self.assertLess(lens["centre_error"], 0.001, name)
-        # DOUBLE_SPHERE's focal length is identifiable: within 0.5%, fx/fy
-        # (square pixels) within 0.1%.
+            # Its focal length (pixels per radian on the axis, which
+            # UNIFIED_OMNI's parameters give as fx / (1 + xi): its fx and xi
+            # trade off at the same projection) within 0.5%, square pixels
+            # within 0.1%.
+            self.assertLess(abs(lens["axis_focal_ratio"] - 1), 0.005, name)
+            fx, fy = lens["axis_focal"]
+            self.assertLess(abs(fx / fy - 1), 0.001, name)
+        # DOUBLE_SPHERE's focal length parameter is identifiable too.
         params = lenses["lens0"]["params"]
         self.assertLess(abs(lenses["lens0"]["focal_ratio"] - 1), 0.005)
         self.assertLess(abs(params[0] / params[1] - 1), 0.001)

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -58,6 +59,27 @@ double FieldOfViewDeg(const Camera& camera, double fraction) {
   return 2 * max_angle * kRadToDeg;
 }
 
+// Pixels per radian along x and along y at the optical axis: the focal
+// length a lens has whatever its model, comparable across models and
+// identifiable where a model's parameters trade off (UNIFIED_OMNI's focal
+// length and xi give the same projection along a curve: its axis focal is
+// fx / (1 + xi)). Central differences of the projection over +-1e-4 rad.
+Eigen::Vector2d AxisFocal(const Camera& camera) {
+  constexpr double kAngle = 1e-4;
+  Eigen::Vector2d focal = Eigen::Vector2d::Constant(
+      std::numeric_limits<double>::quiet_NaN());
+  for (int axis = 0; axis < 2; ++axis) {
+    Eigen::Vector3d plus(0, 0, std::cos(kAngle));
+    Eigen::Vector3d minus = plus;
+    plus(axis) = std::sin(kAngle);
+    minus(axis) = -std::sin(kAngle);
+    const std::optional<Eigen::Vector2d> a = camera.ImgFromCam(plus, false);
+    const std::optional<Eigen::Vector2d> b = camera.ImgFromCam(minus, false);
+    if (a && b) focal(axis) = (*a - *b)(axis) / (2 * kAngle);
+  }
+  return focal;
+}
+
 // The folder of a camera's images ("lens0" of "lens0/frame000.jpg"), or the
 // camera id when its images have no folder.
 std::map<camera_t, std::string> CameraFolders(const Reconstruction& reconstruction) {
@@ -100,7 +122,9 @@ struct LensReport {
   double fov_deg = 0;
   std::optional<Rigid3d> sensor_from_rig;
   // With ground truth.
-  std::optional<double> projection_median_px, projection_max_px, focal_ratio;
+  Eigen::Vector2d axis_focal = Eigen::Vector2d::Zero();
+  std::optional<double> projection_median_px, projection_max_px, focal_ratio,
+      axis_focal_ratio;
   std::optional<double> rotation_error_deg, centre_error;
 };
 
@@ -179,6 +203,7 @@ int RunRigCalibration(int argc, char** argv) {
       lens.name = folder != folders.end() ? folder->second : "camera" + std::to_string(sensor_id.id);
       lens.reference = ref;
       lens.fov_deg = FieldOfViewDeg(lens.camera, radius_fraction);
+      lens.axis_focal = AxisFocal(lens.camera);
       lens.sensor_from_rig = pose;
       lenses.push_back(lens);
     };
@@ -214,6 +239,10 @@ int RunRigCalibration(int argc, char** argv) {
         }
         if (!gt_camera.FocalLengthIdxs().empty() && !lens.camera.FocalLengthIdxs().empty()) {
           lens.focal_ratio = lens.camera.MeanFocalLength() / gt_camera.MeanFocalLength();
+        }
+        if (const double gt_focal = AxisFocal(gt_camera).mean(); std::isfinite(gt_focal) &&
+            std::isfinite(lens.axis_focal.mean())) {
+          lens.axis_focal_ratio = lens.axis_focal.mean() / gt_focal;
         }
         for (const auto& [gt_rig_id, gt_rig] : gt->Rigs()) {
           const sensor_t gt_sensor(SensorType::CAMERA, *gt_camera_id);
@@ -254,6 +283,10 @@ int RunRigCalibration(int argc, char** argv) {
                 << camera.FocalLengthX() / camera.FocalLengthY() << ")";
         }
       }
+      if (lens.axis_focal.allFinite()) {
+        table << std::setprecision(2) << ", on the axis " << lens.axis_focal.x() << " x "
+              << lens.axis_focal.y() << " px/rad";
+      }
       table << std::setprecision(6) << ", params " << camera.ParamsToString() << "\n";
       Eigen::Vector3d centre = Eigen::Vector3d::Zero();
       double angle = 0;
@@ -273,6 +306,9 @@ int RunRigCalibration(int argc, char** argv) {
               << *lens.projection_median_px << " px (median), " << *lens.projection_max_px
               << " px (max)";
         if (lens.focal_ratio) table << std::setprecision(5) << ", focal ratio " << *lens.focal_ratio;
+        if (lens.axis_focal_ratio) {
+          table << std::setprecision(5) << ", on the axis " << *lens.axis_focal_ratio;
+        }
         if (lens.rotation_error_deg) {
           table << std::setprecision(4) << ", rotation error " << *lens.rotation_error_deg
                 << " deg, centre error " << std::setprecision(6) << *lens.centre_error;
@@ -298,6 +334,11 @@ int RunRigCalibration(int argc, char** argv) {
            << ", \"projection_median_px\": " << optional_number(lens.projection_median_px)
            << ", \"projection_max_px\": " << optional_number(lens.projection_max_px)
            << ", \"focal_ratio\": " << optional_number(lens.focal_ratio)
+           << ", \"axis_focal\": "
+           << (lens.axis_focal.allFinite()
+                   ? JsonList({lens.axis_focal.x(), lens.axis_focal.y()})
+                   : "null")
+           << ", \"axis_focal_ratio\": " << optional_number(lens.axis_focal_ratio)
            << ", \"rotation_error_deg\": " << optional_number(lens.rotation_error_deg)
            << ", \"centre_error\": " << optional_number(lens.centre_error) << "}";
       config << (k ? "," : "") << "\n      {\n        \"image_prefix\": \"" << lens.name
