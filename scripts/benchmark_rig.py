@@ -32,6 +32,10 @@ Usage (from the repository root, after scripts/build.sh):
   scripts/benchmark_rig.py                        3 seeds, both presets
   scripts/benchmark_rig.py --repeats 1 --presets dual_fisheye --frames 10
   scripts/benchmark_rig.py --first_seed 1 --repeats 2 ...   adds seeds 1, 2
+  scripts/benchmark_rig.py --start_focal_scale 1.2 --start_no_distortion ...
+                                                  self-calibration: the rig
+                                                  starts from focal lengths
+                                                  20% long, no distortion
 Output (--output, default build/bench_rig): rig_runs.csv (every run),
 rig_results.csv (median and min..max per preset and system, ratios to the
 rig), rig_results.png, logs/.
@@ -80,17 +84,22 @@ def frame_poses(model_path, system, num_lenses):
     return {frame_of(name): pose for name, pose in poses.items()}
 
 
-def rough_rig_config(scene, path):
+def rough_rig_config(scene, path, focal_scale=1.0, no_distortion=False):
     """rig_config.json of the scene with every lens's offset set to zero:
-    what a user knows of a camera (lens directions), not its calibration."""
+    what a user knows of a camera (lens directions), not its calibration;
+    the focal lengths scaled by FOCAL_SCALE and, with NO_DISTORTION, the
+    lenses' distortion unknown (common.rough_intrinsics)."""
     import json
     with open(os.path.join(scene, "rig_config.json")) as f:
-        config = common.without_rig_offsets(json.load(f))
+        config = common.rough_intrinsics(
+            common.without_rig_offsets(json.load(f)), focal_scale,
+            no_distortion)
     with open(path, "w") as f:
         json.dump(config, f, indent=1)
 
 
-def run_system(scene, preset, system, work, program, num_lenses):
+def run_system(scene, preset, system, work, program, num_lenses,
+               start=(1.0, False)):
     """Reconstructs SCENE with SYSTEM; returns a row of results."""
     import json
     os.makedirs(work)
@@ -110,7 +119,7 @@ def run_system(scene, preset, system, work, program, num_lenses):
             "--ImageReader.mask_path", os.path.join(scene, "masks"),
             *extraction], os.path.join(logs, "extract.log"))
         config = os.path.join(work, "rig_config.json")
-        rough_rig_config(scene, config)
+        rough_rig_config(scene, config, *start)
         t_extract += timed(program, [
             "rig_configurator", "--database_path", database,
             "--rig_config_path", config], os.path.join(logs, "rig.log"))
@@ -329,6 +338,11 @@ def main():
     parser.add_argument("--lens_size", type=int, default=0,
                         help="pixels of a lens image (0: the preset's)")
     parser.add_argument("--stitched_width", type=int, default=2048)
+    parser.add_argument("--start_focal_scale", type=float, default=1.0,
+                        help="the rig's start: focal lengths times this")
+    parser.add_argument("--start_no_distortion", action="store_true",
+                        help="the rig's start: distortion unknown "
+                             "(sphera_common.rough_intrinsics)")
     parser.add_argument("--supersample", type=int, default=2,
                         help="rays per pixel side of the renders")
     parser.add_argument("--output", default=os.path.join(REPO, "build",
@@ -394,7 +408,8 @@ def main():
                 log(f"{preset} {system} seed {seed}")
                 try:
                     row = run_system(scene, preset, system, work, program,
-                                     num_lenses)
+                                     num_lenses, (args.start_focal_scale,
+                                                  args.start_no_distortion))
                 except (RuntimeError, OSError, ValueError) as error:
                     row = {"preset": preset, "system": system,
                            "error": str(error).splitlines()[0]}

@@ -345,6 +345,24 @@ def without_rig_offsets(config):
     return config
 
 
+def rough_intrinsics(config, focal_scale=1.0, no_distortion=False):
+    """CONFIG (a rig_config.json list) with every lens's focal lengths scaled
+    by FOCAL_SCALE and, with NO_DISTORTION, what a user who knows only the
+    kind of lens starts from: UNIFIED_OMNI's distortion coefficients zero,
+    EUCM's alpha and beta those of a generic fisheye (0.5, 1: the unified
+    model with xi = 1)."""
+    for rig in config:
+        for camera in rig["cameras"]:
+            params = camera["camera_params"]
+            params[0] *= focal_scale
+            params[1] *= focal_scale
+            if no_distortion and camera["camera_model_name"] == "UNIFIED_OMNI":
+                params[5:9] = [0, 0, 0, 0]
+            if no_distortion and camera["camera_model_name"] == "EUCM":
+                params[4:6] = [0.5, 1]
+    return config
+
+
 def rig_errors(gt_path, model_path):
     """{image folder: (rotation error in degrees, centre error)} of the
     sensor_from_rig poses of the text model at MODEL_PATH against those of

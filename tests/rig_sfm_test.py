@@ -15,7 +15,7 @@ from cli_util import (Database, TempDirTestCase, main_with_render,
                       write_noise_image)
 from sphera_common import (CPU_EXTRACTION, extract_features, match_exhaustive, median,
                            model_to_text, pose_errors, read_text_cameras, read_text_images,
-                           rig_errors, run_colmap, run_render)
+                           rig_errors, rough_intrinsics, run_colmap, run_render)
 
 SCENE = None
 FRAMES = 10
@@ -40,12 +40,8 @@ def rough_config(scene, focal_scale=1.0, no_distortion=False):
     ground truth with the focal length scaled by FOCAL_SCALE and, with
     NO_DISTORTION, UNIFIED_OMNI's distortion coefficients zero."""
     with open(os.path.join(scene, "rig_config.json")) as f:
-        config = json.load(f)
+        config = rough_intrinsics(json.load(f), focal_scale, no_distortion)
     for camera in config[0]["cameras"]:
-        camera["camera_params"][0] *= focal_scale
-        camera["camera_params"][1] *= focal_scale
-        if no_distortion and camera["camera_model_name"] == "UNIFIED_OMNI":
-            camera["camera_params"][5:9] = [0, 0, 0, 0]
         if not camera.get("ref_sensor"):
             camera["cam_from_rig_rotation"] = [0, 0, 1, 0]
             camera["cam_from_rig_translation"] = [0, 0, 0]
