@@ -22,7 +22,10 @@
 // do we: AngularReprojErrorCostFunction and
 // AngularReprojErrorConstantPoseCostFunction, tested against the autodiff
 // AngularReprojErrorCostFunctor; mapping a 360-degree set with the angular
-// residual then costs no more than with the pixel one.
+// residual then costs no more than with the pixel one. The rig costs
+// (upstream's are autodiff) are analytic too, against the autodiff
+// AngularRigReprojErrorCostFunctor: a lens of a rig has 23 to 26 parameters,
+// and autodiff of all of them dominated the mapping of rigs.
 #pragma once
 
 #include "colmap/estimators/cost_functions/quaternion_utils.h"
@@ -376,6 +379,142 @@ class AngularRigReprojErrorConstantRigCostFunctor
   const AngularRigReprojErrorCostFunctor<CameraModel> reproj_cost_;
 };
 
+// The residual of a lens of a rig with analytic derivatives: the point goes
+// through rig_from_world, then cam_from_rig, and the chain rule joins the
+// rotations' Jacobians to the residual's. Any Jacobian may be nullptr (a
+// constant cam_from_rig passes none for it).
+template <typename CameraModel>
+bool AngularRigResidualWithJacobians(const Eigen::Vector2d& point2D,
+                                     const double* point3D_in_world,
+                                     const double* cam_from_rig,
+                                     const double* rig_from_world,
+                                     const double* camera_params,
+                                     double* residuals,
+                                     double* J_point,
+                                     double* J_cam_from_rig,
+                                     double* J_rig_from_world,
+                                     double* J_params) {
+  Eigen::Matrix<double, 3, 4, Eigen::RowMajor> J_rig_quat;
+  Eigen::Matrix<double, 3, 4, Eigen::RowMajor> J_cam_quat;
+  const Eigen::Vector3d point3D_in_rig =
+      QuaternionRotatePointWithJac(
+          rig_from_world,
+          point3D_in_world,
+          J_rig_from_world ? J_rig_quat.data() : nullptr) +
+      Eigen::Map<const Eigen::Vector3d>(rig_from_world + 4);
+  const Eigen::Vector3d point3D_in_cam =
+      QuaternionRotatePointWithJac(cam_from_rig,
+                                   point3D_in_rig.data(),
+                                   J_cam_from_rig ? J_cam_quat.data()
+                                                  : nullptr) +
+      Eigen::Map<const Eigen::Vector3d>(cam_from_rig + 4);
+  const bool geometry = J_point || J_cam_from_rig || J_rig_from_world;
+  Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J_in_cam;
+  if (!AngularReprojResidualWithJacobians<CameraModel>(
+          camera_params,
+          point2D,
+          point3D_in_cam.data(),
+          residuals,
+          geometry ? J_in_cam.data() : nullptr,
+          J_params)) {
+    return false;
+  }
+  if (!geometry) {
+    return true;
+  }
+  using Jacobian2x7 = Eigen::Matrix<double, 2, 7, Eigen::RowMajor>;
+  if (J_cam_from_rig) {
+    Eigen::Map<Jacobian2x7> J(J_cam_from_rig);
+    J.leftCols<4>() = J_in_cam * J_cam_quat;
+    J.rightCols<3>() = J_in_cam;
+  }
+  const Eigen::Matrix<double, 2, 3> J_in_rig =
+      J_in_cam * EigenQuaternionMap<double>(cam_from_rig).toRotationMatrix();
+  if (J_rig_from_world) {
+    Eigen::Map<Jacobian2x7> J(J_rig_from_world);
+    J.leftCols<4>() = J_in_rig * J_rig_quat;
+    J.rightCols<3>() = J_in_rig;
+  }
+  if (J_point) {
+    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> J(J_point);
+    J = J_in_rig *
+        EigenQuaternionMap<double>(rig_from_world).toRotationMatrix();
+  }
+  return true;
+}
+
+// AngularRigReprojErrorCostFunctor with analytic Jacobians: what bundle
+// adjustment uses for a lens of a rig (every observation of a non-reference
+// lens), the autodiff functor being its reference in the tests.
+template <typename CameraModel>
+class AngularRigReprojErrorCostFunction
+    : public ceres::
+          SizedCostFunction<2, 3, 7, 7, CameraModel::num_params> {
+ public:
+  explicit AngularRigReprojErrorCostFunction(const Eigen::Vector2d& point2D)
+      : point2D_(point2D) {}
+
+  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D) {
+    return new AngularRigReprojErrorCostFunction(point2D);
+  }
+
+  bool Evaluate(double const* const* parameters,
+                double* residuals,
+                double** jacobians) const override {
+    return AngularRigResidualWithJacobians<CameraModel>(
+        point2D_,
+        parameters[0],
+        parameters[1],
+        parameters[2],
+        parameters[3],
+        residuals,
+        jacobians ? jacobians[0] : nullptr,
+        jacobians ? jacobians[1] : nullptr,
+        jacobians ? jacobians[2] : nullptr,
+        jacobians ? jacobians[3] : nullptr);
+  }
+
+ private:
+  const Eigen::Vector2d point2D_;
+};
+
+// The same with a constant cam_from_rig
+// (AngularRigReprojErrorConstantRigCostFunctor), analytic.
+template <typename CameraModel>
+class AngularRigReprojErrorConstantRigCostFunction
+    : public ceres::SizedCostFunction<2, 3, 7, CameraModel::num_params> {
+ public:
+  AngularRigReprojErrorConstantRigCostFunction(const Eigen::Vector2d& point2D,
+                                               const Rigid3d& cam_from_rig)
+      : point2D_(point2D), cam_from_rig_(cam_from_rig.params) {}
+
+  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D,
+                                     const Rigid3d& cam_from_rig) {
+    return new AngularRigReprojErrorConstantRigCostFunction(point2D,
+                                                            cam_from_rig);
+  }
+
+  bool Evaluate(double const* const* parameters,
+                double* residuals,
+                double** jacobians) const override {
+    return AngularRigResidualWithJacobians<CameraModel>(
+        point2D_,
+        parameters[0],
+        cam_from_rig_.data(),
+        parameters[1],
+        parameters[2],
+        residuals,
+        jacobians ? jacobians[0] : nullptr,
+        nullptr,
+        jacobians ? jacobians[1] : nullptr,
+        jacobians ? jacobians[2] : nullptr);
+  }
+
+ private:
+  const Eigen::Vector2d point2D_;
+  const Eigen::Matrix<double, 7, 1> cam_from_rig_;
+};
+
 // The angular cost that takes the place of an upstream pixel functor.
 template <template <typename> class PixelFunctor>
 struct AngularFunctorOf;
@@ -397,12 +536,12 @@ struct AngularFunctorOf<ReprojErrorConstantPoint3DCostFunctor> {
 template <>
 struct AngularFunctorOf<RigReprojErrorCostFunctor> {
   template <typename M>
-  using type = AngularRigReprojErrorCostFunctor<M>;
+  using type = AngularRigReprojErrorCostFunction<M>;
 };
 template <>
 struct AngularFunctorOf<RigReprojErrorConstantRigCostFunctor> {
   template <typename M>
-  using type = AngularRigReprojErrorConstantRigCostFunctor<M>;
+  using type = AngularRigReprojErrorConstantRigCostFunction<M>;
 };
 
 // CreateCameraCostFunction<PixelFunctor>, with the angular residual in its

@@ -1,8 +1,9 @@
 // The analytic angular cost functions that bundle adjustment uses for
-// spherical cameras against the autodiff functors they replace: the same
-// residual, the same Jacobians for every parameter block (any subset asked
-// for), for points in front of, beside and behind each lens, at zero error,
-// and the same refusal of a pixel outside the image.
+// spherical cameras (single cameras and lenses of rigs) against the autodiff
+// functors they replace: the same residual, the same Jacobians for every
+// parameter block (any subset asked for), for points in front of, beside and
+// behind each lens, at zero error, and the same refusal of a pixel outside
+// the image.
 #include "colmap_ext/estimators/sphere_cost_functions.h"
 
 #include "colmap/geometry/rigid3.h"
@@ -200,6 +201,68 @@ TEST_P(SphereCostFunction, AnalyticMatchesAutoDiff) {
           Evaluate(*analytic_constant_pose, constant_pose_parameters, mask),
           reference_evaluation,
           "constant pose, mask " + std::to_string(mask));
+    }
+  }
+  if (camera.model_id != CameraModelId::kEquirectangular) {
+    EXPECT_GT(num_behind, 5) << "no rays behind the image plane were tested";
+  }
+}
+
+TEST_P(SphereCostFunction, RigAnalyticMatchesAutoDiff) {
+  const Camera camera = MakeCamera();
+  std::mt19937 rng(11);
+  const Rigid3d rig_from_world(
+      Eigen::Quaterniond(Eigen::AngleAxisd(-0.4, Eigen::Vector3d(2, -1, 1)
+                                                     .normalized())),
+      Eigen::Vector3d(-0.5, 0.8, 1.5));
+  // A lens turned well away from the reference and 4 cm off it.
+  const Rigid3d cam_from_rig(
+      Eigen::Quaterniond(Eigen::AngleAxisd(2.5, Eigen::Vector3d(0.1, 1, 0.2)
+                                                    .normalized())),
+      Eigen::Vector3d(0.03, -0.01, 0.025));
+  const Rigid3d cam_from_world = cam_from_rig * rig_from_world;
+  int num_behind = 0;
+  for (const auto& observation : Observations(camera, cam_from_world, &rng)) {
+    num_behind += (cam_from_world * observation.point3D).z() < 0;
+    std::unique_ptr<ceres::CostFunction> analytic(
+        CreateSphereCameraCostFunction<RigReprojErrorCostFunctor>(
+            SphereResidualType::ANGULAR, camera, observation.pixel));
+    std::unique_ptr<ceres::CostFunction> reference(
+        CreateCameraCostFunction<AngularRigReprojErrorCostFunctor>(
+            camera.model_id, observation.pixel));
+    EXPECT_NE(typeid(*analytic), typeid(*reference));
+    const std::vector<const double*> parameters = {
+        observation.point3D.data(),
+        cam_from_rig.params.data(),
+        rig_from_world.params.data(),
+        camera.params.data()};
+    for (int mask = 0; mask < 16; ++mask) {
+      ExpectSameEvaluation(Evaluate(*analytic, parameters, mask),
+                           Evaluate(*reference, parameters, mask),
+                           "rig, mask " + std::to_string(mask));
+    }
+
+    std::unique_ptr<ceres::CostFunction> analytic_constant_rig(
+        CreateSphereCameraCostFunction<RigReprojErrorConstantRigCostFunctor>(
+            SphereResidualType::ANGULAR,
+            camera,
+            observation.pixel,
+            cam_from_rig));
+    // Reference: the autodiff rig functor with cam_from_rig not asked for.
+    const std::vector<const double*> constant_rig_parameters = {
+        observation.point3D.data(),
+        rig_from_world.params.data(),
+        camera.params.data()};
+    for (int mask = 0; mask < 8; ++mask) {
+      Evaluation reference_evaluation =
+          Evaluate(*reference, parameters, (mask & 1) | ((mask & 6) << 1));
+      reference_evaluation.jacobians = {reference_evaluation.jacobians[0],
+                                        reference_evaluation.jacobians[2],
+                                        reference_evaluation.jacobians[3]};
+      ExpectSameEvaluation(
+          Evaluate(*analytic_constant_rig, constant_rig_parameters, mask),
+          reference_evaluation,
+          "constant rig, mask " + std::to_string(mask));
     }
   }
   if (camera.model_id != CameraModelId::kEquirectangular) {
