@@ -348,37 +348,6 @@ class AngularRigReprojErrorCostFunctor
   const Eigen::Vector2d point2D_;
 };
 
-template <typename CameraModel>
-class AngularRigReprojErrorConstantRigCostFunctor
-    : public AutoDiffCostFunctor<
-          AngularRigReprojErrorConstantRigCostFunctor<CameraModel>,
-          2,
-          3,
-          7,
-          CameraModel::num_params> {
- public:
-  AngularRigReprojErrorConstantRigCostFunctor(const Eigen::Vector2d& point2D,
-                                              const Rigid3d& cam_from_rig)
-      : cam_from_rig_(cam_from_rig), reproj_cost_(point2D) {}
-
-  template <typename T>
-  bool operator()(const T* const point3D_in_world,
-                  const T* const rig_from_world,
-                  const T* const camera_params,
-                  T* residuals) const {
-    const Eigen::Matrix<T, 7, 1> cam_from_rig = cam_from_rig_.params.cast<T>();
-    return reproj_cost_(point3D_in_world,
-                        cam_from_rig.data(),
-                        rig_from_world,
-                        camera_params,
-                        residuals);
-  }
-
- private:
-  const Rigid3d cam_from_rig_;
-  const AngularRigReprojErrorCostFunctor<CameraModel> reproj_cost_;
-};
-
 // The residual of a lens of a rig with analytic derivatives: the point goes
 // through rig_from_world, then cam_from_rig, and the chain rule joins the
 // rotations' Jacobians to the residual's. Any Jacobian may be nullptr (a
@@ -478,8 +447,8 @@ class AngularRigReprojErrorCostFunction
   const Eigen::Vector2d point2D_;
 };
 
-// The same with a constant cam_from_rig
-// (AngularRigReprojErrorConstantRigCostFunctor), analytic.
+// The same with a constant cam_from_rig (upstream's
+// RigReprojErrorConstantRigCostFunctor), analytic only.
 template <typename CameraModel>
 class AngularRigReprojErrorConstantRigCostFunction
     : public ceres::SizedCostFunction<2, 3, 7, CameraModel::num_params> {
