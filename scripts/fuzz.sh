@@ -128,7 +128,8 @@ build_target() {
 # -- seeds ------------------------------------------------------------------
 make_seeds() {
   local seeds="${WORK}/seeds"
-  [ -f "${seeds}/done" ] && [ -d "${seeds}/fuzz_rig_config" ] && return
+  # "done" names the version of this recipe: seeds of an older one are remade.
+  [ "$(cat "${seeds}/done" 2>/dev/null)" = 2 ] && return
   rm -rf "${seeds}" "${WORK}/scene" "${WORK}/scene_png" "${WORK}"/rig_*
   mkdir -p "${seeds}/fuzz_database_check" "${seeds}/fuzz_image_bytes" \
     "${seeds}/fuzz_model_readers" "${seeds}/fuzz_camera_params" \
@@ -141,8 +142,11 @@ make_seeds() {
     printf "%b" "${line}" > "${seeds}/fuzz_camera_params/seed${k}"
     k=$((k + 1))
   done
-  "${RENDER}" --output "${WORK}/scene" --layout ring --num_cameras 2 \
-    --width 96 --height 72 --supersample 1 >/dev/null
+  # Two neighbours of a ring of 16: the matcher verifies their pair (it
+  # exits 1 when no pair is verified).
+  "${RENDER}" --output "${WORK}/scene" --layout ring --num_cameras 16 \
+    --width 128 --height 96 --supersample 1 >/dev/null
+  printf 'cam000.jpg\ncam001.jpg\n' > "${WORK}/scene/pair.txt"
   "${RENDER}" --output "${WORK}/scene_png" --layout ring --num_cameras 2 \
     --width 48 --height 36 --supersample 1 --format png >/dev/null
   # Rig configs: the renderer's true rigs (model, params, poses) and one
@@ -159,8 +163,8 @@ make_seeds() {
   local db="${WORK}/seed.db"
   rm -f "${db}"
   "${COLMAP}" feature_extractor --database_path "${db}" \
-    --image_path "${WORK}/scene/images" --FeatureExtraction.use_gpu 0 \
-    --SiftExtraction.max_num_features 24 >/dev/null 2>&1
+    --image_path "${WORK}/scene/images" --image_list_path "${WORK}/scene/pair.txt" \
+    --FeatureExtraction.use_gpu 0 --SiftExtraction.max_num_features 48 >/dev/null 2>&1
   "${COLMAP}" exhaustive_matcher --database_path "${db}" \
     --FeatureMatching.use_gpu 0 >/dev/null 2>&1
   # One file, no write-ahead log beside it.
@@ -196,7 +200,7 @@ for binary, (folder, extension) in enumerate((("text", ".txt"), ("binary", ".bin
         with open(f"{seeds}/{folder}_{name}", "wb") as f:
             f.write(bytes([(index << 1) | binary]) + data)
 EOF
-  touch "${seeds}/done"
+  echo 2 > "${seeds}/done"
 }
 
 # -- run --------------------------------------------------------------------
