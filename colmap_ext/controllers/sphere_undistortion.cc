@@ -489,17 +489,55 @@ bool IsCubeMappedModel(const CameraModelId model_id) {
   }
 }
 
-bool ViewPixelToSourcePixel(const Camera& source,
-                            const Camera& view,
-                            const Eigen::Matrix3d& cam_from_view,
-                            const Eigen::Vector2d& view_pixel,
-                            Eigen::Vector2d* source_pixel) {
+std::vector<Eigen::Vector3d> OtherLensAxes(const Reconstruction& reconstruction,
+                                           const Image& image) {
+  std::vector<Eigen::Vector3d> axes;
+  if (!image.HasFrameId() || !reconstruction.ExistsFrame(image.FrameId())) {
+    return axes;
+  }
+  const Eigen::Quaterniond cam_from_world = image.CamFromWorld().rotation();
+  for (const data_t& data_id :
+       reconstruction.Frame(image.FrameId()).ImageIds()) {
+    if (data_id.id == image.ImageId() ||
+        !reconstruction.ExistsImage(data_id.id)) {
+      continue;
+    }
+    const Image& other = reconstruction.Image(data_id.id);
+    if (!other.HasPose()) {
+      continue;
+    }
+    axes.push_back(cam_from_world * (other.CamFromWorld().rotation().inverse() *
+                                     Eigen::Vector3d::UnitZ()));
+  }
+  return axes;
+}
+
+bool NearestLens(const std::vector<Eigen::Vector3d>& other_lens_axes,
+                 const Eigen::Vector3d& ray) {
+  for (const Eigen::Vector3d& axis : other_lens_axes) {
+    if (axis.dot(ray) > ray.z()) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool ViewPixelToSourcePixel(
+    const Camera& source,
+    const Camera& view,
+    const Eigen::Matrix3d& cam_from_view,
+    const Eigen::Vector2d& view_pixel,
+    Eigen::Vector2d* source_pixel,
+    const std::vector<Eigen::Vector3d>& other_lens_axes) {
   const std::optional<Eigen::Vector3d> ray_in_view =
       PixelRay(view, view_pixel);
   if (!ray_in_view.has_value()) {
     return false;
   }
   const Eigen::Vector3d ray_in_cam = cam_from_view * *ray_in_view;
+  if (!NearestLens(other_lens_axes, ray_in_cam)) {
+    return false;
+  }
   const std::optional<Eigen::Vector2d> pixel = RayPixel(source, ray_in_cam);
   if (!pixel.has_value()) {
     return false;
@@ -525,7 +563,8 @@ bool ViewPixelToSourcePixel(const Camera& source,
 
 RemapMaps BuildRemapMaps(const Camera& source,
                          const Camera& view,
-                         const Eigen::Matrix3d& cam_from_view) {
+                         const Eigen::Matrix3d& cam_from_view,
+                         const std::vector<Eigen::Vector3d>& other_lens_axes) {
   RemapMaps maps;
   const int width = static_cast<int>(view.width);
   const int height = static_cast<int>(view.height);
@@ -541,7 +580,8 @@ RemapMaps BuildRemapMaps(const Camera& source,
                                  view,
                                  cam_from_view,
                                  Eigen::Vector2d(col + 0.5, row + 0.5),
-                                 &source_pixel)) {
+                                 &source_pixel,
+                                 other_lens_axes)) {
         // COLMAP's pixel centres are at +0.5, OpenCV's at integers.
         map_x[col] = static_cast<float>(source_pixel.x() - 0.5);
         map_y[col] = static_cast<float>(source_pixel.y() - 0.5);
@@ -699,6 +739,7 @@ SphereExportSummary ExportPerspectiveWorkspace(
 
   // Maps of the views of the last source camera (usually one camera).
   camera_t cached_camera_id = kInvalidCameraId;
+  std::vector<Eigen::Vector3d> cached_other_axes;
   std::map<int, RemapMaps> cached_maps;
 
   image_t next_image_id = 1;
@@ -727,9 +768,19 @@ SphereExportSummary ExportPerspectiveWorkspace(
               << camera.width << "x" << camera.height;
       throw std::invalid_argument(message.str());
     }
-    if (camera.camera_id != cached_camera_id) {
+    // per_frame: the directions this lens leaves to the others of its frame
+    // (in a rig the same for every frame, so the maps stay cached).
+    const std::vector<Eigen::Vector3d> other_axes =
+        options.per_frame ? OtherLensAxes(reconstruction, image)
+                          : std::vector<Eigen::Vector3d>();
+    bool same_axes = other_axes.size() == cached_other_axes.size();
+    for (size_t k = 0; same_axes && k < other_axes.size(); ++k) {
+      same_axes = (other_axes[k] - cached_other_axes[k]).norm() < 1e-9;
+    }
+    if (camera.camera_id != cached_camera_id || !same_axes) {
       cached_maps.clear();
       cached_camera_id = camera.camera_id;
+      cached_other_axes = other_axes;
     }
     // The source's mask: its file, or every pixel valid.
     cv::Mat source_mask;
@@ -765,7 +816,8 @@ SphereExportSummary ExportPerspectiveWorkspace(
                      .emplace(view.cache_key,
                               BuildRemapMaps(camera,
                                              view.camera,
-                                             view.view_from_cam.transpose()))
+                                             view.view_from_cam.transpose(),
+                                             cached_other_axes))
                      .first;
       }
       const RemapMaps& maps = cached->second;
@@ -800,7 +852,7 @@ SphereExportSummary ExportPerspectiveWorkspace(
           cam_from_world;
       std::vector<Point2D> view_points2D;
       for (size_t k = 0; k < points2D.size(); ++k) {
-        if (!rays[k].has_value()) {
+        if (!rays[k].has_value() || !NearestLens(other_axes, *rays[k])) {
           continue;
         }
         const std::optional<Eigen::Vector2d> xy =

@@ -84,6 +84,16 @@ struct SphereUndistorterOptions {
   // mask carried into the view (nearest pixel), 0 where the view sees no
   // source pixel. An image without a mask file counts as unmasked.
   std::string mask_path;
+  // true: the lenses of a rig frame share its directions instead of each
+  // writing every face it sees. A face pixel of a lens is kept only where
+  // its ray is nearer that lens's optical axis (+z) than the axis of any
+  // other registered image of the same frame, so each direction around a
+  // frame comes from one lens (the one that sees it nearest its centre) and
+  // the overlap of the lenses is not written twice; faces left with more
+  // than max_invalid_ratio of such pixels are dropped. Views stay exact
+  // pinhole views of one lens each (no stitching, no parallax). Images
+  // alone in their frame are unaffected.
+  bool per_frame = false;
 
   // Empty when valid; otherwise a message naming the offending option.
   std::string Check() const;
@@ -129,12 +139,25 @@ bool IsCubeMappedModel(CameraModelId model_id);
 // The source pixel (COLMAP convention: pixel centres at +0.5) seen by
 // `view_pixel` of a view camera rotated by `cam_from_view` at the source
 // camera's centre. False when the view ray is not visible in the source
-// image.
-bool ViewPixelToSourcePixel(const Camera& source,
-                            const Camera& view,
-                            const Eigen::Matrix3d& cam_from_view,
-                            const Eigen::Vector2d& view_pixel,
-                            Eigen::Vector2d* source_pixel);
+// image, or when it is nearer one of `other_lens_axes` (unit vectors in the
+// source camera's frame) than the source's own optical axis (+z).
+bool ViewPixelToSourcePixel(
+    const Camera& source,
+    const Camera& view,
+    const Eigen::Matrix3d& cam_from_view,
+    const Eigen::Vector2d& view_pixel,
+    Eigen::Vector2d* source_pixel,
+    const std::vector<Eigen::Vector3d>& other_lens_axes = {});
+
+// The optical axes (+z) of the other registered images of `image`'s frame,
+// in `image`'s camera frame (empty for an image alone in its frame).
+std::vector<Eigen::Vector3d> OtherLensAxes(const Reconstruction& reconstruction,
+                                           const Image& image);
+
+// True when `ray` (source camera frame) is at least as near the source's
+// optical axis (+z) as every one of `other_lens_axes`.
+bool NearestLens(const std::vector<Eigen::Vector3d>& other_lens_axes,
+                 const Eigen::Vector3d& ray);
 
 // cv::remap maps (OpenCV convention: pixel centres at integers) from a view
 // to the source image; pixels without a source hold kInvalidMapValue.
@@ -145,9 +168,11 @@ struct RemapMaps {
 };
 constexpr float kInvalidMapValue = -1e6f;
 
-RemapMaps BuildRemapMaps(const Camera& source,
-                         const Camera& view,
-                         const Eigen::Matrix3d& cam_from_view);
+RemapMaps BuildRemapMaps(
+    const Camera& source,
+    const Camera& view,
+    const Eigen::Matrix3d& cam_from_view,
+    const std::vector<Eigen::Vector3d>& other_lens_axes = {});
 
 // Bilinear resampling of `source_image` (the image of `source`) through the
 // maps; the equirectangular seam wraps around, pixels without a source are

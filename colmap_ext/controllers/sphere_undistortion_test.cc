@@ -706,6 +706,209 @@ TEST(SphereUndistorter, SplattingLayoutAndFaceSubset) {
   EXPECT_GT(num_observations, exported.NumPoints3D());
 }
 
+// Two back-to-back 200-degree DOUBLE_SPHERE lenses 3 cm apart in one rig,
+// two frames, with full masks: the per-frame export writes every direction
+// around a frame from exactly one lens, the one nearer its axis; the
+// per-lens export writes the lenses' overlap twice.
+TEST(SphereUndistorter, PerFrameSharesTheDirectionsOfARigFrame) {
+  TempDir temp;
+  const fs::path image_dir = temp.path() / "images_in";
+  const fs::path mask_dir = temp.path() / "masks_in";
+  Reconstruction reconstruction;
+  Rig rig;
+  rig.SetRigId(1);
+  for (camera_t camera_id : {1, 2}) {
+    Camera camera;
+    camera.camera_id = camera_id;
+    camera.model_id = CameraModelId::kDoubleSphere;
+    camera.width = 128;
+    camera.height = 128;
+    camera.params = {29.5, 29.5, 64, 64, -0.2, 0.6};
+    reconstruction.AddCamera(camera);
+  }
+  rig.AddRefSensor(sensor_t(SensorType::CAMERA, 1));
+  // Lens 1 looks backwards (180 degrees about y), its centre 3 cm behind.
+  const Eigen::Quaterniond back(Eigen::AngleAxisd(kPi, Eigen::Vector3d::UnitY()));
+  rig.AddSensor(sensor_t(SensorType::CAMERA, 2),
+                PoseFromCenter(back, Eigen::Vector3d(0, 0, -0.03)));
+  reconstruction.AddRig(rig);
+  const std::vector<Rigid3d> rig_from_world = {
+      PoseFromCenter(Eigen::Quaterniond(Eigen::AngleAxisd(
+                         0.3, Eigen::Vector3d(0.2, 1, 0.1).normalized())),
+                     Eigen::Vector3d(0.1, 0, 0.2)),
+      PoseFromCenter(Eigen::Quaterniond(Eigen::AngleAxisd(
+                         -0.7, Eigen::Vector3d(0, 1, 0.3).normalized())),
+                     Eigen::Vector3d(0.5, -0.1, 0.4))};
+  std::mt19937 rng(3);
+  std::vector<Eigen::Vector3d> markers;
+  for (int k = 0; k < 40; ++k) {
+    markers.push_back(3 * RandomUnit(&rng));
+  }
+  for (size_t f = 0; f < rig_from_world.size(); ++f) {
+    Frame frame;
+    frame.SetFrameId(f + 1);
+    frame.SetRigId(1);
+    for (camera_t camera_id : {1, 2}) {
+      frame.AddDataId(data_t(sensor_t(SensorType::CAMERA, camera_id),
+                             2 * f + camera_id));
+    }
+    frame.SetRigFromWorld(rig_from_world[f]);
+    reconstruction.AddFrame(frame);
+    for (camera_t camera_id : {1, 2}) {
+      Image image;
+      image.SetImageId(2 * f + camera_id);
+      image.SetCameraId(camera_id);
+      image.SetFrameId(f + 1);
+      const std::string lens = "lens" + std::to_string(camera_id - 1);
+      image.SetName(lens + "/f" + std::to_string(f) + ".png");
+      reconstruction.AddImage(image);
+    }
+    reconstruction.RegisterFrame(f + 1);
+  }
+  std::vector<Track> tracks(markers.size());
+  for (const image_t image_id : reconstruction.RegImageIds()) {
+    Image& image = reconstruction.Image(image_id);
+    const Camera& camera = reconstruction.Camera(image.CameraId());
+    std::vector<Point2D> points2D;
+    for (size_t j = 0; j < markers.size(); ++j) {
+      const std::optional<Eigen::Vector2d> xy =
+          camera.ImgFromCam(image.CamFromWorld() * markers[j]);
+      if (xy.has_value() && xy->x() > 0 && xy->y() > 0 && xy->x() < 128 &&
+          xy->y() < 128) {
+        Point2D point2D;
+        point2D.xy = *xy;
+        tracks[j].AddElement(image_id, points2D.size());
+        points2D.push_back(point2D);
+      }
+    }
+    image.SetPoints2D(points2D);
+    for (const fs::path& dir : {image_dir, mask_dir}) {
+      fs::create_directories((dir / image.Name()).parent_path());
+    }
+    // Bright dots at the markers; beyond the model's valid radius, black.
+    cv::Mat lens_image(128, 128, CV_8UC1, cv::Scalar(0));
+    for (int row = 0; row < 128; ++row) {
+      for (int col = 0; col < 128; ++col) {
+        const std::optional<Eigen::Vector3d> ray =
+            camera.CamRayFromImg(Eigen::Vector2d(col + 0.5, row + 0.5));
+        if (!ray.has_value()) {
+          continue;
+        }
+        double value = 10;
+        for (const Eigen::Vector3d& marker : markers) {
+          const double angle = std::acos(std::min(
+              1.0,
+              ray->normalized().dot(
+                  (image.CamFromWorld() * marker).normalized())));
+          value += 240 * std::exp(-angle * angle / (2 * 0.05 * 0.05));
+        }
+        lens_image.at<uint8_t>(row, col) =
+            static_cast<uint8_t>(std::min(255.0, value));
+      }
+    }
+    cv::imwrite((image_dir / image.Name()).string(), lens_image);
+    cv::imwrite((mask_dir / (image.Name() + ".png")).string(),
+                cv::Mat(128, 128, CV_8U, cv::Scalar(255)));
+  }
+  for (size_t j = 0; j < markers.size(); ++j) {
+    Point3D point;
+    point.xyz = markers[j];
+    point.track = tracks[j];
+    if (point.track.Length() > 0) {
+      reconstruction.AddPoint3D(j + 1, point);
+    }
+  }
+  ASSERT_GT(reconstruction.NumPoints3D(), 30);
+
+  // For random directions around each frame (rig frame), the views of that
+  // frame whose mask keeps the direction, and their lenses.
+  struct Coverage {
+    size_t once = 0, twice = 0, none = 0, wrong_lens = 0;
+  };
+  auto export_coverage = [&](const bool per_frame,
+                             SphereExportSummary* summary) {
+    SphereUndistorterOptions options;
+    options.per_frame = per_frame;
+    options.mask_path = mask_dir.string();
+    options.face_size = 48;
+    options.image_format = "png";
+    const fs::path output =
+        temp.path() / (per_frame ? "per_frame" : "per_lens");
+    *summary = ExportPerspectiveWorkspace(
+        reconstruction, image_dir.string(), output.string(), options);
+    Reconstruction exported;
+    exported.Read((output / "sparse").string());
+    std::map<std::string, cv::Mat> masks;
+    for (const auto& [view_id, view] : exported.Images()) {
+      masks[view.Name()] =
+          cv::imread((output / "masks" / (view.Name() + ".png")).string(),
+                     cv::IMREAD_GRAYSCALE);
+      EXPECT_FALSE(masks[view.Name()].empty()) << view.Name();
+    }
+    Coverage coverage;
+    std::mt19937 sample_rng(11);
+    for (size_t f = 0; f < rig_from_world.size(); ++f) {
+      for (int k = 0; k < 3000; ++k) {
+        const Eigen::Vector3d ray_in_rig = RandomUnit(&sample_rng);
+        const Eigen::Vector3d ray_in_world =
+            rig_from_world[f].rotation().inverse() * ray_in_rig;
+        int seen = 0;
+        for (const auto& [view_id, view] : exported.Images()) {
+          if (view.Name().find("/f" + std::to_string(f) + "_") ==
+              std::string::npos) {
+            continue;
+          }
+          const Camera& camera = exported.Camera(view.CameraId());
+          const Eigen::Vector3d ray_in_view =
+              view.CamFromWorld().rotation() * ray_in_world;
+          const std::optional<Eigen::Vector2d> xy =
+              camera.ImgFromCam(ray_in_view);
+          if (ray_in_view.z() <= 0 || !xy.has_value() || xy->x() < 0 ||
+              xy->y() < 0 || xy->x() >= camera.width ||
+              xy->y() >= camera.height) {
+            continue;
+          }
+          const cv::Mat& mask = masks.at(view.Name());
+          if (mask.empty() ||
+              mask.at<uint8_t>(static_cast<int>(xy->y()),
+                               static_cast<int>(xy->x())) == 0) {
+            continue;
+          }
+          ++seen;
+          // Lens 0 looks along +z of the rig, lens 1 along -z.
+          const bool lens0 = view.Name().rfind("lens0/", 0) == 0;
+          if ((lens0 ? ray_in_rig.z() : -ray_in_rig.z()) < -0.02) {
+            ++coverage.wrong_lens;
+          }
+        }
+        ++(seen == 0 ? coverage.none
+                     : (seen == 1 ? coverage.once : coverage.twice));
+      }
+    }
+    return coverage;
+  };
+  SphereExportSummary per_lens_summary, per_frame_summary;
+  const Coverage per_lens = export_coverage(false, &per_lens_summary);
+  const Coverage per_frame = export_coverage(true, &per_frame_summary);
+  LOG(INFO) << "directions seen once/twice/never, wrong lens: per lens "
+            << per_lens.once << "/" << per_lens.twice << "/" << per_lens.none
+            << ", " << per_lens.wrong_lens << "; per frame " << per_frame.once
+            << "/" << per_frame.twice << "/" << per_frame.none << ", "
+            << per_frame.wrong_lens;
+  // Per lens: the 200-degree lenses overlap in a 20-degree band around the
+  // rig's equator (about 17% of the sphere), seen twice.
+  EXPECT_GT(per_lens.twice, 600);
+  EXPECT_LT(per_lens.none, 60);
+  // Per frame: every direction once (up to pixels on a boundary), and from
+  // the lens whose hemisphere it is in.
+  EXPECT_LT(per_frame.twice, 60);
+  EXPECT_LT(per_frame.none, 60);
+  EXPECT_EQ(per_frame.wrong_lens, 0);
+  EXPECT_LT(per_frame_summary.num_observations,
+            per_lens_summary.num_observations);
+  EXPECT_EQ(per_frame_summary.num_views, per_lens_summary.num_views);
+}
+
 TEST(SphereUndistorter, FailuresLeaveNothingBehind) {
   TempDir temp;
   const fs::path image_dir = temp.path() / "images_in";

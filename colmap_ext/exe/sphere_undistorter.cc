@@ -42,6 +42,10 @@ int RunSphereUndistorter(int argc, char** argv) {
       "image_format", &export_options.image_format, "{jpg, png}");
   options.AddDefaultOption("jpeg_quality", &export_options.jpeg_quality);
   options.AddDefaultOption("mask_path", &export_options.mask_path);
+  options.AddDefaultOption(
+      "per_frame",
+      &export_options.per_frame,
+      "each direction of a rig frame from one lens, the nearest its axis");
   if (!options.Parse(argc, argv)) {
     return EXIT_FAILURE;
   }
