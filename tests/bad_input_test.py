@@ -283,7 +283,27 @@ class BadDatabaseTest(BadInputCase):
                                      "a database was created")
                     if case == "empty":
                         self.assertEqual(os.path.getsize(database), 0)
-        self.assertEqual(runs, 8)
+            # The database named by a project file (--project_path).
+            project = self.path(f"{case}.ini")
+            with open(project, "w") as f:
+                f.write(f"database_path={database}\n"
+                        f"image_path={Scene.images}\n")
+            for command in ("exhaustive_matcher", "mapper"):
+                with self.subTest(case=case, command=command, project=True):
+                    out = self.path(f"out_{case}_project_{command}")
+                    os.makedirs(out)
+                    args = [command, "--project_path", project]
+                    if command == "mapper":
+                        args += ["--image_path", Scene.images,
+                                 "--output_path", out]
+                    code, output = run_bounded(args)
+                    self.assert_named_error(code, output, [database, case],
+                                            case)
+                    self.assertEqual(os.listdir(out), [], "output written")
+                    self.assertEqual(os.path.exists(database),
+                                     case == "empty", "a database was created")
+                    runs += 1
+        self.assertEqual(runs, 12)
 
     def test_database_without_images_is_a_named_error(self):
         database = self.path("no_images.db")

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <set>
@@ -541,17 +543,37 @@ std::string MissingDatabaseError(const std::string& command, int argc,
   if (kCreating.count(command)) {
     return "";
   }
-  const std::string option = "--database_path";
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    std::string path;
-    if (arg == option && i + 1 < argc) {
-      path = argv[i + 1];
-    } else if (arg.rfind(option + "=", 0) == 0) {
-      path = arg.substr(option.size() + 1);
-    } else {
-      continue;
+  // The value of `--NAME VALUE` or `--NAME=VALUE`.
+  const auto values_of = [&](const std::string& name) {
+    const std::string option = "--" + name;
+    std::vector<std::string> values;
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      if (arg == option && i + 1 < argc) {
+        values.push_back(argv[i + 1]);
+      } else if (arg.rfind(option + "=", 0) == 0) {
+        values.push_back(arg.substr(option.size() + 1));
+      }
     }
+    return values;
+  };
+  std::vector<std::string> paths = values_of("database_path");
+  // A project file (--project_path) names its database in a line
+  // `database_path=PATH`.
+  for (const std::string& project : values_of("project_path")) {
+    std::ifstream file(project);
+    std::string line;
+    while (std::getline(file, line)) {
+      const std::string key = "database_path=";
+      const size_t start = line.find_first_not_of(" \t");
+      if (start != std::string::npos && line.compare(start, key.size(), key) == 0) {
+        std::string path = line.substr(start + key.size());
+        path.erase(path.find_last_not_of(" \t\r") + 1);
+        paths.push_back(path);
+      }
+    }
+  }
+  for (const std::string& path : paths) {
     std::error_code error;
     if (!std::filesystem::exists(path, error)) {
       return "database " + path +

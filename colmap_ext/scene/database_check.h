@@ -26,8 +26,9 @@ namespace colmap {
 // new database) passes.
 void CheckDatabaseFile(const std::filesystem::path& path, int format_version);
 
-// Empty, or why `colmap COMMAND ARGS` cannot run: its --database_path names
-// a file that does not exist or is empty, and the command only reads and
+// Empty, or why `colmap COMMAND ARGS` cannot run: its --database_path (or
+// the database_path of its --project_path file) names a file that does not
+// exist or is empty, and the command only reads and
 // adds to a database (every command but feature_extractor,
 // feature_importer, database_creator, automatic_reconstructor and gui,
 // which create one). COLMAP would create an empty database there and then
