@@ -737,7 +737,8 @@ SphereExportSummary ExportPerspectiveWorkspace(
   SphereExportSummary summary;
   summary.num_input_images = image_ids.size();
 
-  // Maps of the views of the last source camera (usually one camera).
+  // Maps of the views of the last source camera (usually one camera) and,
+  // with per_frame, of the other lens axes of its frame.
   camera_t cached_camera_id = kInvalidCameraId;
   std::vector<Eigen::Vector3d> cached_other_axes;
   std::map<int, RemapMaps> cached_maps;

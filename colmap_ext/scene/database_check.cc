@@ -566,7 +566,8 @@ std::string MissingDatabaseError(const std::string& command, int argc,
     while (std::getline(file, line)) {
       const std::string key = "database_path=";
       const size_t start = line.find_first_not_of(" \t");
-      if (start != std::string::npos && line.compare(start, key.size(), key) == 0) {
+      if (start != std::string::npos &&
+          line.compare(start, key.size(), key) == 0) {
         std::string path = line.substr(start + key.size());
         path.erase(path.find_last_not_of(" \t\r") + 1);
         paths.push_back(path);
