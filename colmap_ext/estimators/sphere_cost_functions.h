@@ -11,9 +11,14 @@
 //
 // so |r| is the geodesic angle between u and v (no image seam, no weight that
 // grows towards the poles, smooth at zero). It is divided by the camera's
-// radians per pixel at the current parameters (a unit conversion, not
-// differentiated), so that robust-loss scales and error statistics stay in
-// pixels. Intrinsics enter through u, so they can be refined.
+// radians per pixel at the parameters the cost function is made with, so
+// that robust-loss scales and error statistics stay in pixels. That unit is a
+// constant of the cost function: scaled by the radians per pixel of the
+// parameters being refined, the cost would fall with the focal length alone,
+// and derivatives that leave the scale out would not be those of the cost
+// (bundle adjustment then stalls with the trust region collapsing, as a
+// self-calibrated lens did). A problem built again after a solve takes the
+// new unit. Intrinsics enter through u, so they can be refined.
 //
 // Each functor below has the parameter blocks of the upstream pixel functor
 // of the same name without "Angular" (reprojection_error.h), so that
@@ -57,11 +62,25 @@ struct SphereMathOf<CameraModel,
   using type = typename CameraModel::sphere_model;
 };
 
-// The residual of one observation: the one body behind every functor below.
+// The pixels per radian of a spherical camera with CAMERA_PARAMS: the unit of
+// its angular residual (1 for the perspective models, which never take it).
+template <typename CameraModel>
+double AngularPixelsPerRadian(const double* camera_params) {
+  using SphereModel = typename SphereMathOf<CameraModel>::type;
+  if constexpr (std::is_void_v<SphereModel>) {
+    return 1.0;
+  } else {
+    return 1.0 / SphereModel::PixelToAngle(camera_params);
+  }
+}
+
+// The residual of one observation: the one body behind every functor below,
+// in units of 1 / PIXELS_PER_RADIAN radians.
 template <typename CameraModel, typename T>
 bool AngularReprojResidual(const T* camera_params,
                            const Eigen::Vector2d& observed_pixel,
                            const Eigen::Matrix<T, 3, 1>& point3D_in_cam,
+                           const double pixels_per_radian,
                            T* residuals) {
   using SphereModel = typename SphereMathOf<CameraModel>::type;
   if constexpr (std::is_void_v<SphereModel>) {
@@ -73,13 +92,8 @@ bool AngularReprojResidual(const T* camera_params,
       return false;
     }
     sphera::AngularLogResidual(observed_ray, point3D_in_cam.data(), residuals);
-    double scalar_params[CameraModel::num_params];
-    for (size_t i = 0; i < CameraModel::num_params; ++i) {
-      scalar_params[i] = sphera::internal::ScalarPart(camera_params[i]);
-    }
-    const T pixels_per_radian(1.0 / SphereModel::PixelToAngle(scalar_params));
-    residuals[0] *= pixels_per_radian;
-    residuals[1] *= pixels_per_radian;
+    residuals[0] *= T(pixels_per_radian);
+    residuals[1] *= T(pixels_per_radian);
     return true;
   }
 }
@@ -93,6 +107,7 @@ template <typename CameraModel>
 bool AngularReprojResidualWithJacobians(const double* camera_params,
                                         const Eigen::Vector2d& observed_pixel,
                                         const double* point3D_in_cam,
+                                        const double pixels_per_radian,
                                         double* residuals,
                                         double* J_point_in_cam,
                                         double* J_params) {
@@ -101,8 +116,6 @@ bool AngularReprojResidualWithJacobians(const double* camera_params,
     return false;
   } else {
     constexpr int kNumParams = static_cast<int>(CameraModel::num_params);
-    const double pixels_per_radian =
-        1.0 / SphereModel::PixelToAngle(camera_params);
     if (J_params == nullptr) {
       const double pixel[2] = {observed_pixel.x(), observed_pixel.y()};
       double observed_ray[3];
@@ -159,11 +172,14 @@ template <typename CameraModel>
 class AngularReprojErrorCostFunction
     : public ceres::SizedCostFunction<2, 3, 7, CameraModel::num_params> {
  public:
-  explicit AngularReprojErrorCostFunction(const Eigen::Vector2d& point2D)
-      : point2D_(point2D) {}
+  AngularReprojErrorCostFunction(const double* camera_params,
+                                 const Eigen::Vector2d& point2D)
+      : point2D_(point2D),
+        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)) {}
 
-  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D) {
-    return new AngularReprojErrorCostFunction(point2D);
+  static ceres::CostFunction* Create(const double* camera_params,
+                                     const Eigen::Vector2d& point2D) {
+    return new AngularReprojErrorCostFunction(camera_params, point2D);
   }
 
   bool Evaluate(double const* const* parameters,
@@ -186,6 +202,7 @@ class AngularReprojErrorCostFunction
             parameters[2],
             point2D_,
             point3D_in_cam.data(),
+            pixels_per_radian_,
             residuals,
             (J_point || J_pose) ? J_in_cam.data() : nullptr,
             J_params)) {
@@ -209,6 +226,7 @@ class AngularReprojErrorCostFunction
 
  private:
   const Eigen::Vector2d point2D_;
+  const double pixels_per_radian_;
 };
 
 // The same with a constant pose (upstream's
@@ -217,16 +235,19 @@ template <typename CameraModel>
 class AngularReprojErrorConstantPoseCostFunction
     : public ceres::SizedCostFunction<2, 3, CameraModel::num_params> {
  public:
-  AngularReprojErrorConstantPoseCostFunction(const Eigen::Vector2d& point2D,
+  AngularReprojErrorConstantPoseCostFunction(const double* camera_params,
+                                             const Eigen::Vector2d& point2D,
                                              const Rigid3d& cam_from_world)
       : point2D_(point2D),
+        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)),
         cam_from_world_rotation_(cam_from_world.rotation().toRotationMatrix()),
         cam_from_world_translation_(cam_from_world.translation()) {}
 
-  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D,
+  static ceres::CostFunction* Create(const double* camera_params,
+                                     const Eigen::Vector2d& point2D,
                                      const Rigid3d& cam_from_world) {
-    return new AngularReprojErrorConstantPoseCostFunction(point2D,
-                                                          cam_from_world);
+    return new AngularReprojErrorConstantPoseCostFunction(
+        camera_params, point2D, cam_from_world);
   }
 
   bool Evaluate(double const* const* parameters,
@@ -243,6 +264,7 @@ class AngularReprojErrorConstantPoseCostFunction
             parameters[1],
             point2D_,
             point3D_in_cam.data(),
+            pixels_per_radian_,
             residuals,
             J_point ? J_in_cam.data() : nullptr,
             J_params)) {
@@ -258,6 +280,7 @@ class AngularReprojErrorConstantPoseCostFunction
 
  private:
   const Eigen::Vector2d point2D_;
+  const double pixels_per_radian_;
   const Eigen::Matrix3d cam_from_world_rotation_;
   const Eigen::Vector3d cam_from_world_translation_;
 };
@@ -270,8 +293,10 @@ class AngularReprojErrorCostFunctor
                                  7,
                                  CameraModel::num_params> {
  public:
-  explicit AngularReprojErrorCostFunctor(const Eigen::Vector2d& point2D)
-      : point2D_(point2D) {}
+  AngularReprojErrorCostFunctor(const double* camera_params,
+                                const Eigen::Vector2d& point2D)
+      : point2D_(point2D),
+        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)) {}
 
   template <typename T>
   bool operator()(const T* const point3D_in_world,
@@ -283,11 +308,12 @@ class AngularReprojErrorCostFunctor
             EigenVector3Map<T>(point3D_in_world) +
         EigenVector3Map<T>(cam_from_world + 4);
     return AngularReprojResidual<CameraModel>(
-        camera_params, point2D_, point3D_in_cam, residuals);
+        camera_params, point2D_, point3D_in_cam, pixels_per_radian_, residuals);
   }
 
  private:
   const Eigen::Vector2d point2D_;
+  const double pixels_per_radian_;
 };
 
 template <typename CameraModel>
@@ -299,8 +325,11 @@ class AngularReprojErrorConstantPoint3DCostFunctor
           CameraModel::num_params> {
  public:
   AngularReprojErrorConstantPoint3DCostFunctor(
-      const Eigen::Vector2d& point2D, const Eigen::Vector3d& point3D_in_world)
-      : point3D_in_world_(point3D_in_world), reproj_cost_(point2D) {}
+      const double* camera_params,
+      const Eigen::Vector2d& point2D,
+      const Eigen::Vector3d& point3D_in_world)
+      : point3D_in_world_(point3D_in_world),
+        reproj_cost_(camera_params, point2D) {}
 
   template <typename T>
   bool operator()(const T* const cam_from_world,
@@ -325,8 +354,10 @@ class AngularRigReprojErrorCostFunctor
                                  7,
                                  CameraModel::num_params> {
  public:
-  explicit AngularRigReprojErrorCostFunctor(const Eigen::Vector2d& point2D)
-      : point2D_(point2D) {}
+  AngularRigReprojErrorCostFunctor(const double* camera_params,
+                                   const Eigen::Vector2d& point2D)
+      : point2D_(point2D),
+        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)) {}
 
   template <typename T>
   bool operator()(const T* const point3D_in_world,
@@ -341,11 +372,12 @@ class AngularRigReprojErrorCostFunctor
              EigenVector3Map<T>(rig_from_world + 4)) +
         EigenVector3Map<T>(cam_from_rig + 4);
     return AngularReprojResidual<CameraModel>(
-        camera_params, point2D_, point3D_in_cam, residuals);
+        camera_params, point2D_, point3D_in_cam, pixels_per_radian_, residuals);
   }
 
  private:
   const Eigen::Vector2d point2D_;
+  const double pixels_per_radian_;
 };
 
 // The residual of a lens of a rig with analytic derivatives: the point goes
@@ -354,6 +386,7 @@ class AngularRigReprojErrorCostFunctor
 // constant cam_from_rig passes none for it).
 template <typename CameraModel>
 bool AngularRigResidualWithJacobians(const Eigen::Vector2d& point2D,
+                                     const double pixels_per_radian,
                                      const double* point3D_in_world,
                                      const double* cam_from_rig,
                                      const double* rig_from_world,
@@ -383,6 +416,7 @@ bool AngularRigResidualWithJacobians(const Eigen::Vector2d& point2D,
           camera_params,
           point2D,
           point3D_in_cam.data(),
+          pixels_per_radian,
           residuals,
           geometry ? J_in_cam.data() : nullptr,
           J_params)) {
@@ -420,11 +454,14 @@ class AngularRigReprojErrorCostFunction
     : public ceres::
           SizedCostFunction<2, 3, 7, 7, CameraModel::num_params> {
  public:
-  explicit AngularRigReprojErrorCostFunction(const Eigen::Vector2d& point2D)
-      : point2D_(point2D) {}
+  AngularRigReprojErrorCostFunction(const double* camera_params,
+                                    const Eigen::Vector2d& point2D)
+      : point2D_(point2D),
+        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)) {}
 
-  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D) {
-    return new AngularRigReprojErrorCostFunction(point2D);
+  static ceres::CostFunction* Create(const double* camera_params,
+                                     const Eigen::Vector2d& point2D) {
+    return new AngularRigReprojErrorCostFunction(camera_params, point2D);
   }
 
   bool Evaluate(double const* const* parameters,
@@ -432,6 +469,7 @@ class AngularRigReprojErrorCostFunction
                 double** jacobians) const override {
     return AngularRigResidualWithJacobians<CameraModel>(
         point2D_,
+        pixels_per_radian_,
         parameters[0],
         parameters[1],
         parameters[2],
@@ -445,6 +483,7 @@ class AngularRigReprojErrorCostFunction
 
  private:
   const Eigen::Vector2d point2D_;
+  const double pixels_per_radian_;
 };
 
 // The same with a constant cam_from_rig (upstream's
@@ -453,14 +492,18 @@ template <typename CameraModel>
 class AngularRigReprojErrorConstantRigCostFunction
     : public ceres::SizedCostFunction<2, 3, 7, CameraModel::num_params> {
  public:
-  AngularRigReprojErrorConstantRigCostFunction(const Eigen::Vector2d& point2D,
+  AngularRigReprojErrorConstantRigCostFunction(const double* camera_params,
+                                               const Eigen::Vector2d& point2D,
                                                const Rigid3d& cam_from_rig)
-      : point2D_(point2D), cam_from_rig_(cam_from_rig.params) {}
+      : point2D_(point2D),
+        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)),
+        cam_from_rig_(cam_from_rig.params) {}
 
-  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D,
+  static ceres::CostFunction* Create(const double* camera_params,
+                                     const Eigen::Vector2d& point2D,
                                      const Rigid3d& cam_from_rig) {
-    return new AngularRigReprojErrorConstantRigCostFunction(point2D,
-                                                            cam_from_rig);
+    return new AngularRigReprojErrorConstantRigCostFunction(
+        camera_params, point2D, cam_from_rig);
   }
 
   bool Evaluate(double const* const* parameters,
@@ -468,6 +511,7 @@ class AngularRigReprojErrorConstantRigCostFunction
                 double** jacobians) const override {
     return AngularRigResidualWithJacobians<CameraModel>(
         point2D_,
+        pixels_per_radian_,
         parameters[0],
         cam_from_rig_.data(),
         parameters[1],
@@ -481,6 +525,7 @@ class AngularRigReprojErrorConstantRigCostFunction
 
  private:
   const Eigen::Vector2d point2D_;
+  const double pixels_per_radian_;
   const Eigen::Matrix<double, 7, 1> cam_from_rig_;
 };
 
@@ -514,14 +559,15 @@ struct AngularFunctorOf<RigReprojErrorConstantRigCostFunctor> {
 };
 
 // CreateCameraCostFunction<PixelFunctor>, with the angular residual in its
-// place for a spherical camera when `residual` is ANGULAR.
+// place for a spherical camera when `residual` is ANGULAR, in the pixels of
+// CAMERA's parameters as they are now.
 template <template <typename> class PixelFunctor, typename... Args>
 ceres::CostFunction* CreateSphereCameraCostFunction(
     const SphereResidualType residual, const Camera& camera, Args&&... args) {
   if (residual == SphereResidualType::ANGULAR && camera.IsSpherical()) {
     return CreateCameraCostFunction<
         AngularFunctorOf<PixelFunctor>::template type>(
-        camera.model_id, std::forward<Args>(args)...);
+        camera.model_id, camera.params.data(), std::forward<Args>(args)...);
   }
   return CreateCameraCostFunction<PixelFunctor>(camera.model_id,
                                                 std::forward<Args>(args)...);

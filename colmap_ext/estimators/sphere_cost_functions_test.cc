@@ -3,7 +3,10 @@
 // functors they replace: the same residual, the same Jacobians for every
 // parameter block (any subset asked for), for points in front of, beside and
 // behind each lens, at zero error, and the same refusal of a pixel outside
-// the image.
+// the image. And the Jacobian of the camera parameters against finite
+// differences of the cost itself: the residual's unit (pixels per radian)
+// is fixed when the cost is made, so the derivatives are those of the cost
+// that the solver sees.
 #include "colmap_ext/estimators/sphere_cost_functions.h"
 
 #include "colmap/geometry/rigid3.h"
@@ -171,7 +174,7 @@ TEST_P(SphereCostFunction, AnalyticMatchesAutoDiff) {
             SphereResidualType::ANGULAR, camera, observation.pixel));
     std::unique_ptr<ceres::CostFunction> reference(
         CreateCameraCostFunction<AngularReprojErrorCostFunctor>(
-            camera.model_id, observation.pixel));
+            camera.model_id, camera.params.data(), observation.pixel));
     EXPECT_NE(typeid(*analytic), typeid(*reference));
     const std::vector<const double*> parameters = {
         observation.point3D.data(),
@@ -229,7 +232,7 @@ TEST_P(SphereCostFunction, RigAnalyticMatchesAutoDiff) {
             SphereResidualType::ANGULAR, camera, observation.pixel));
     std::unique_ptr<ceres::CostFunction> reference(
         CreateCameraCostFunction<AngularRigReprojErrorCostFunctor>(
-            camera.model_id, observation.pixel));
+            camera.model_id, camera.params.data(), observation.pixel));
     EXPECT_NE(typeid(*analytic), typeid(*reference));
     const std::vector<const double*> parameters = {
         observation.point3D.data(),
@@ -279,8 +282,8 @@ TEST_P(SphereCostFunction, PixelOutsideTheImageIsRefusedLikeAutoDiff) {
       CreateSphereCameraCostFunction<ReprojErrorCostFunctor>(
           SphereResidualType::ANGULAR, camera, outside));
   std::unique_ptr<ceres::CostFunction> reference(
-      CreateCameraCostFunction<AngularReprojErrorCostFunctor>(camera.model_id,
-                                                              outside));
+      CreateCameraCostFunction<AngularReprojErrorCostFunctor>(
+          camera.model_id, camera.params.data(), outside));
   const std::vector<const double*> parameters = {
       point3D.data(), cam_from_world.params.data(), camera.params.data()};
   const Evaluation analytic_evaluation = Evaluate(*analytic, parameters, 7);
@@ -289,6 +292,79 @@ TEST_P(SphereCostFunction, PixelOutsideTheImageIsRefusedLikeAutoDiff) {
   if (camera.model_id == CameraModelId::kEquirectangular) {
     EXPECT_FALSE(analytic_evaluation.ok);
   }
+}
+
+// The camera-parameter Jacobian (last block) of COST at PARAMETERS against
+// central differences of COST's own residual.
+void ExpectParamsJacobianIsTheDerivative(
+    const ceres::CostFunction& cost,
+    std::vector<const double*> parameters,
+    const std::string& what) {
+  const size_t last = parameters.size() - 1;
+  const int num_params = cost.parameter_block_sizes()[last];
+  const Evaluation evaluation =
+      Evaluate(cost, parameters, 1 << static_cast<int>(last));
+  ASSERT_TRUE(evaluation.ok) << what;
+  std::vector<double> params(parameters[last], parameters[last] + num_params);
+  parameters[last] = params.data();
+  for (int i = 0; i < num_params; ++i) {
+    const double value = params[i];
+    const double step = 1e-6 * (1 + std::abs(value));
+    params[i] = value + step;
+    const Evaluation plus = Evaluate(cost, parameters, 0);
+    params[i] = value - step;
+    const Evaluation minus = Evaluate(cost, parameters, 0);
+    params[i] = value;
+    ASSERT_TRUE(plus.ok && minus.ok) << what;
+    for (int row = 0; row < 2; ++row) {
+      const double numeric =
+          (plus.residuals[row] - minus.residuals[row]) / (2 * step);
+      EXPECT_NEAR(evaluation.jacobians[last][row * num_params + i],
+                  numeric,
+                  1e-5 * (1 + std::abs(numeric)))
+          << what << " parameter " << i << " row " << row;
+    }
+  }
+}
+
+TEST_P(SphereCostFunction, ParamsJacobianIsTheDerivativeOfTheCost) {
+  const Camera camera = MakeCamera();
+  std::mt19937 rng(13);
+  const Rigid3d rig_from_world(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, -1, 2)
+                                                    .normalized())),
+      Eigen::Vector3d(0.2, 0.4, -1.0));
+  const Rigid3d cam_from_rig(
+      Eigen::Quaterniond(Eigen::AngleAxisd(kPi, Eigen::Vector3d::UnitY())),
+      Eigen::Vector3d(0, 0, -0.03));
+  const Rigid3d cam_from_world = cam_from_rig * rig_from_world;
+  int num_with_error = 0;
+  for (const auto& observation : Observations(camera, cam_from_world, &rng)) {
+    std::unique_ptr<ceres::CostFunction> single(
+        CreateSphereCameraCostFunction<ReprojErrorCostFunctor>(
+            SphereResidualType::ANGULAR, camera, observation.pixel));
+    const std::vector<const double*> single_parameters = {
+        observation.point3D.data(),
+        cam_from_world.params.data(),
+        camera.params.data()};
+    const Evaluation evaluation = Evaluate(*single, single_parameters, 0);
+    ASSERT_TRUE(evaluation.ok);
+    num_with_error += std::hypot(evaluation.residuals[0],
+                                 evaluation.residuals[1]) > 0.1;
+    ExpectParamsJacobianIsTheDerivative(*single, single_parameters, "single");
+    std::unique_ptr<ceres::CostFunction> rig(
+        CreateSphereCameraCostFunction<RigReprojErrorCostFunctor>(
+            SphereResidualType::ANGULAR, camera, observation.pixel));
+    ExpectParamsJacobianIsTheDerivative(*rig,
+                                        {observation.point3D.data(),
+                                         cam_from_rig.params.data(),
+                                         rig_from_world.params.data(),
+                                         camera.params.data()},
+                                        "rig");
+  }
+  // Most observations are off their point by a fraction of a degree: the
+  // residual's unit would change their residual with the focal length.
+  EXPECT_GT(num_with_error, 30);
 }
 
 INSTANTIATE_TEST_SUITE_P(SphereModels,
