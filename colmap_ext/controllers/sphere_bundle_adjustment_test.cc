@@ -4,6 +4,7 @@
 #include "colmap/scene/camera.h"
 #include "colmap/scene/image.h"
 #include "colmap/scene/reconstruction.h"
+#include "colmap/sfm/observation_manager.h"
 #include "colmap_ext/exe/sphere_bundle_adjuster.h"
 
 #include <unistd.h>
@@ -205,6 +206,39 @@ TEST(SphereBundleAdjustment, CameraOnlyNoiseFree) {
   EXPECT_EQ(summary.num_points_after, 200u);
   EXPECT_LT(summary.mean_error_after_px, 1e-5);
   EXPECT_GT(summary.mean_error_before_px, 1);
+}
+
+// The filter the mappers run before every global bundle adjustment: a point
+// that sits at a spherical camera's centre (where the angular residual has no
+// direction and its derivatives blow up) loses that observation; a point a
+// centimetre from a camera in a 4 m room is kept, as is everything else.
+TEST(SphereBundleAdjustment, PointAtACameraCentreIsFilteredBeforeAdjustment) {
+  std::mt19937 rng(5);
+  Reconstruction rec = MakeRoom(200, 0, 0, false, &rng, nullptr);
+  const Image& image = rec.Image(1);
+  std::vector<point2D_t> observed;
+  for (point2D_t idx = 0; idx < image.NumPoints2D(); ++idx) {
+    const Point2D& point2D = image.Point2D(idx);
+    if (point2D.HasPoint3D() &&
+        rec.Point3D(point2D.point3D_id).track.Length() >= 3) {
+      observed.push_back(idx);
+    }
+  }
+  ASSERT_GE(observed.size(), 2u);
+  const point3D_t collapsed = image.Point2D(observed[0]).point3D_id;
+  const point3D_t near = image.Point2D(observed[1]).point3D_id;
+  const Eigen::Vector3d center = image.ProjectionCenter();
+  rec.Point3D(collapsed).xyz =
+      center + 1e-9 * (rec.Point3D(collapsed).xyz - center).normalized();
+  rec.Point3D(near).xyz =
+      center + 0.01 * (rec.Point3D(near).xyz - center).normalized();
+  const size_t num_observations = rec.ComputeNumObservations();
+
+  EXPECT_EQ(ObservationManager(rec).FilterObservationsWithNegativeDepth(), 1u);
+  EXPECT_FALSE(rec.Image(1).Point2D(observed[0]).HasPoint3D());
+  EXPECT_TRUE(rec.ExistsPoint3D(collapsed));
+  EXPECT_TRUE(rec.Image(1).Point2D(observed[1]).HasPoint3D());
+  EXPECT_EQ(rec.ComputeNumObservations(), num_observations - 1);
 }
 
 TEST(SphereBundleAdjustment, ModesWithNoiseAndOutliers) {
