@@ -23,24 +23,18 @@ Output (--output, default build/bench_self_calibration):
 self_calibration_runs.csv (every run), self_calibration.png, logs/.
 """
 import argparse
-import csv
 import json
 import os
 import shutil
 import sys
-import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sphera_common as common  # noqa: E402
-from benchmark_rig import rough_rig_config, timed  # noqa: E402
+from benchmark_rig import log, rough_rig_config, timed, write_csv  # noqa: E402
 
 FRAMES = 10
 MAX_PROJECTION_PX = 0.5
 MAX_CENTRE_ERROR_MM = 1.0
-
-
-def log(message):
-    print(f"[{time.strftime('%H:%M:%S')}] {message}", flush=True)
 
 
 def prepare(work, program, render):
@@ -112,16 +106,6 @@ def run_seed(seed, scene, configured, work, program):
             for lens in lenses.values()) and
         row["lens1_centre_mm"] < MAX_CENTRE_ERROR_MM)
     return row
-
-
-def write_csv(path, rows):
-    keys = []
-    for row in rows:
-        keys += [k for k in row if k not in keys]
-    with open(path, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=keys)
-        writer.writeheader()
-        writer.writerows(rows)
 
 
 def write_png(path, rows):
