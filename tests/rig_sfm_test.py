@@ -236,6 +236,33 @@ class DualFisheyeRigTest(TempDirTestCase):
         return run_colmap("rig_configurator", "--database_path", database,
                           "--rig_config_path", path, *options, check=check)
 
+    def assertLensParams(self, database, config):
+        """Every image of DATABASE under a lens's prefix has a camera with
+        the lens's parameters in CONFIG, and each lens its own camera."""
+        import struct
+        expected = {c["image_prefix"]: c["camera_params"]
+                    for c in config[0]["cameras"]}
+        db = Database(database)
+        rows = db.connection.execute(
+            "SELECT images.name, cameras.camera_id, cameras.params FROM "
+            "images JOIN cameras ON images.camera_id = cameras.camera_id"
+            ).fetchall()
+        db.close()
+        lens_cameras = {}
+        for name, camera_id, blob in rows:
+            prefix = name.split("/")[0] + "/"
+            lens_cameras.setdefault(prefix, set()).add(camera_id)
+            params = struct.unpack(f"<{len(blob) // 8}d", blob)
+            self.assertEqual(len(params), len(expected[prefix]), name)
+            for value, want in zip(params, expected[prefix]):
+                self.assertAlmostEqual(value, want, delta=1e-9 * abs(want),
+                                       msg=name)
+        self.assertEqual(sorted(lens_cameras), sorted(expected))
+        self.assertEqual(len(set.union(*lens_cameras.values())),
+                         len(expected))
+        for cameras in lens_cameras.values():
+            self.assertEqual(len(cameras), 1)
+
     def match_and_map(self, database):
         """Exhaustive matching and the mapper into sparse/; one model, as
         text in text/."""
@@ -330,6 +357,54 @@ class DualFisheyeRigTest(TempDirTestCase):
         shutil.copy(database, fresh)
         run_colmap("rig_configurator", "--database_path", fresh,
                    "--rig_config_path", os.path.join(out, "rig_config.json"))
+        with open(os.path.join(out, "rig_config.json")) as f:
+            self.assertLensParams(fresh, json.load(f))
+        # With --input_path and a config without the lens's pose in the
+        # rig, the pose comes from the model and the intrinsics from the
+        # config (here every focal length 20% long): into the database and
+        # the output model alike, each lens its own.
+        reconfigured = self.path("reconfigured.db")
+        shutil.copy(database, reconfigured)
+        os.makedirs(self.path("reconfigured"))
+        config = rough_config(SCENE, focal_scale=1.2)
+        for camera in config[0]["cameras"]:
+            camera.pop("cam_from_rig_rotation", None)
+            camera.pop("cam_from_rig_translation", None)
+        self.configure(reconfigured, config, "--input_path",
+                       self.path("sparse", "0"), "--output_path",
+                       self.path("reconfigured"))
+        self.assertLensParams(reconfigured, config)
+        import struct
+        db = Database(reconfigured)
+        blobs = [row[0] for row in db.connection.execute(
+            "SELECT sensor_from_rig FROM rig_sensors")]
+        db.close()
+        self.assertEqual(len(blobs), 1)  # the back lens
+        with open(self.path("text", "rigs.txt")) as f:
+            rig_line = [line for line in f if not line.startswith("#")][0]
+        # The model's own pose of the back lens (the rig holds in every
+        # frame, so their average is it): QW QX QY QZ TX TY TZ, not zero.
+        model_pose = [float(v) for v in rig_line.split()[-7:]]
+        self.assertGreater(sum(v * v for v in model_pose[4:]), 1e-4)
+        pose = list(struct.unpack("<7d", blobs[0]))
+        if sum(a * b for a, b in zip(pose[:4], model_pose[:4])) < 0:
+            pose[:4] = [-v for v in pose[:4]]  # q and -q: the same rotation
+        for value, want in zip(pose, model_pose):
+            self.assertAlmostEqual(value, want, delta=1e-6)
+        model_to_text(self.path("reconfigured"),
+                      self.path("reconfigured_text"))
+        expected = {c["camera_model_name"]: c["camera_params"]
+                    for c in config[0]["cameras"]}
+        for model, _, _, params in read_text_cameras(
+                self.path("reconfigured_text")).values():
+            self.assertEqual(len(params), len(expected[model]), model)
+            for value, want in zip(params, expected[model]):
+                self.assertAlmostEqual(value, want, delta=1e-9 * abs(want))
+        for lens, (rotation, centre) in rig_errors(
+                os.path.join(SCENE, "sparse_gt"),
+                self.path("reconfigured_text")).items():
+            self.assertLess(rotation, 0.02, lens)
+            self.assertLess(centre, 0.0005, lens)
         # Cube faces of every lens image with the image-circle masks carried
         # into them: a face pixel the mask keeps comes from inside the circle.
         run_colmap("sphere_undistorter", "--input_path", self.path("sparse", "0"),
