@@ -323,6 +323,14 @@ def write_png(path, summary):
     fig.savefig(path, dpi=110)
 
 
+def add_program_arguments(parser):
+    """--colmap and --render: the programs of the build by default."""
+    parser.add_argument("--colmap", default=os.path.join(REPO, "build", "bin",
+                                                         "colmap"))
+    parser.add_argument("--render", default=os.path.join(
+        REPO, "build", "synthetic", "sphera_render"))
+
+
 def main():
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
@@ -347,10 +355,7 @@ def main():
                         help="rays per pixel side of the renders")
     parser.add_argument("--output", default=os.path.join(REPO, "build",
                                                          "bench_rig"))
-    parser.add_argument("--colmap", default=os.path.join(REPO, "build", "bin",
-                                                         "colmap"))
-    parser.add_argument("--render", default=os.path.join(
-        REPO, "build", "synthetic", "sphera_render"))
+    add_program_arguments(parser)
     parser.add_argument("--upstream_colmap", default=common.UPSTREAM_COLMAP)
     parser.add_argument("--no_upstream", action="store_true")
     args = parser.parse_args()

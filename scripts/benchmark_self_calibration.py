@@ -36,7 +36,8 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sphera_common as common  # noqa: E402
-from benchmark_rig import log, rough_rig_config, timed, write_csv  # noqa: E402
+from benchmark_rig import (add_program_arguments, log,  # noqa: E402
+                           rough_rig_config, timed, write_csv)
 
 FRAMES = 10
 MAX_PROJECTION_PX = 0.5
@@ -157,10 +158,7 @@ def main():
     parser.add_argument("--start", choices=sorted(STARTS), default="rough",
                         help="rough: focal lengths 20%% long, no "
                         "distortion; known: the true intrinsics")
-    parser.add_argument("--colmap", default=os.path.join(
-        common.REPO_ROOT, "build", "bin", "colmap"))
-    parser.add_argument("--render", default=os.path.join(
-        common.REPO_ROOT, "build", "synthetic", "sphera_render"))
+    add_program_arguments(parser)
     args = parser.parse_args()
     for program in (args.colmap, args.render):
         if not program or not os.path.exists(program):

@@ -10,6 +10,7 @@ import hashlib
 import json
 import os
 import shutil
+import struct
 
 from cli_util import (Database, TempDirTestCase, main_with_render,
                       write_noise_image)
@@ -197,7 +198,6 @@ class SuffixFramesTest(TempDirTestCase):
             self.assertEqual(lens_camera.setdefault(lens, camera_id),
                              camera_id, name)
         self.assertEqual(len(set(lens_camera.values())), 3)
-        import struct
         for lens, camera_id in lens_camera.items():
             model, blob = db.connection.execute(
                 "SELECT model, params FROM cameras WHERE camera_id = ?",
@@ -236,27 +236,26 @@ class DualFisheyeRigTest(TempDirTestCase):
         return run_colmap("rig_configurator", "--database_path", database,
                           "--rig_config_path", path, *options, check=check)
 
+    def assertParams(self, params, expected, msg):
+        """PARAMS are EXPECTED to a relative 1e-9."""
+        self.assertEqual(len(params), len(expected), msg)
+        for value, want in zip(params, expected):
+            self.assertAlmostEqual(value, want, delta=1e-9 * abs(want),
+                                   msg=msg)
+
     def assertLensParams(self, database, config):
         """Every image of DATABASE under a lens's prefix has a camera with
         the lens's parameters in CONFIG, and each lens its own camera."""
-        import struct
         expected = {c["image_prefix"]: c["camera_params"]
                     for c in config[0]["cameras"]}
         db = Database(database)
-        rows = db.connection.execute(
-            "SELECT images.name, cameras.camera_id, cameras.params FROM "
-            "images JOIN cameras ON images.camera_id = cameras.camera_id"
-            ).fetchall()
+        cameras, images = db.cameras(), db.images()
         db.close()
         lens_cameras = {}
-        for name, camera_id, blob in rows:
+        for name, camera_id in images.items():
             prefix = name.split("/")[0] + "/"
             lens_cameras.setdefault(prefix, set()).add(camera_id)
-            params = struct.unpack(f"<{len(blob) // 8}d", blob)
-            self.assertEqual(len(params), len(expected[prefix]), name)
-            for value, want in zip(params, expected[prefix]):
-                self.assertAlmostEqual(value, want, delta=1e-9 * abs(want),
-                                       msg=name)
+            self.assertParams(cameras[camera_id][3], expected[prefix], name)
         self.assertEqual(sorted(lens_cameras), sorted(expected))
         self.assertEqual(len(set.union(*lens_cameras.values())),
                          len(expected))
@@ -374,7 +373,6 @@ class DualFisheyeRigTest(TempDirTestCase):
                        self.path("sparse", "0"), "--output_path",
                        self.path("reconfigured"))
         self.assertLensParams(reconfigured, config)
-        import struct
         db = Database(reconfigured)
         blobs = [row[0] for row in db.connection.execute(
             "SELECT sensor_from_rig FROM rig_sensors")]
@@ -397,9 +395,7 @@ class DualFisheyeRigTest(TempDirTestCase):
                     for c in config[0]["cameras"]}
         for model, _, _, params in read_text_cameras(
                 self.path("reconfigured_text")).values():
-            self.assertEqual(len(params), len(expected[model]), model)
-            for value, want in zip(params, expected[model]):
-                self.assertAlmostEqual(value, want, delta=1e-9 * abs(want))
+            self.assertParams(params, expected[model], model)
         for lens, (rotation, centre) in rig_errors(
                 os.path.join(SCENE, "sparse_gt"),
                 self.path("reconfigured_text")).items():
