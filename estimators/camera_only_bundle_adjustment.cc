@@ -318,26 +318,22 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
           i);
     }
   }
-  const bool fix_gauge = options.gauge == GaugeFixing::kFirstTwoCameras;
   const int g0 = options.gauge_image0;
   const int g1 = options.gauge_image1;
   double gauge_distance = 0;
   const double scene_scale = SceneScale(poses);
-  if (fix_gauge) {
-    if (num_images < 2 || g0 < 0 || g1 < 0 || g0 >= num_images ||
-        g1 >= num_images || g0 == g1) {
-      return finish(CameraOnlyBAStatus::kInvalidInput,
-                    "gauge_image0/gauge_image1 must be two distinct images");
-    }
-    gauge_distance = (poses[g1].Center() - poses[g0].Center()).norm();
-    if (!(gauge_distance > 1e-9 * scene_scale)) {
-      return finish(CameraOnlyBAStatus::kDegenerateGeometry,
-                    "the gauge cameras " + std::to_string(g0) + " and " +
-                        std::to_string(g1) +
-                        " share their centre (baseline " +
-                        Fmt("%g", gauge_distance) +
-                        "): the scale cannot be fixed");
-    }
+  if (num_images < 2 || g0 < 0 || g1 < 0 || g0 >= num_images ||
+      g1 >= num_images || g0 == g1) {
+    return finish(CameraOnlyBAStatus::kInvalidInput,
+                  "gauge_image0/gauge_image1 must be two distinct images");
+  }
+  gauge_distance = (poses[g1].Center() - poses[g0].Center()).norm();
+  if (!(gauge_distance > 1e-9 * scene_scale)) {
+    return finish(CameraOnlyBAStatus::kDegenerateGeometry,
+                  "the gauge cameras " + std::to_string(g0) + " and " +
+                      std::to_string(g1) + " share their centre (baseline " +
+                      Fmt("%g", gauge_distance) +
+                      "): the scale cannot be fixed");
   }
 
   // ---- Outer iterations ------------------------------------------------
@@ -376,8 +372,7 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
       }
     }
     for (int i = 0; i < num_images; ++i) {
-      const bool fixed = fix_gauge && i == g0;
-      if (fixed) continue;
+      if (i == g0) continue;
       if (static_cast<int>(refs[i].size()) <
           options.min_observations_per_image) {
         return finish(
@@ -422,12 +417,10 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
     if (iter == 1) result.initial_mean_error_rad = stats.mean_error_before_rad;
 
     // ---- Pose step (Eq. 6) over the reliable points. ----
-    // kFixed: the points are constants (resection of every camera, block
-    // diagonal). kImplicit: the points enter as functions of the poses: they
-    // are nuisance blocks, eliminated by the Schur complement in every
-    // Gauss-Newton step (variable projection), then discarded; the next
-    // iteration re-triangulates them from the new poses.
-    const bool implicit_points = options.points == PointHandling::kImplicit;
+    // The points enter as functions of the poses: they are nuisance blocks,
+    // eliminated by the Schur complement in every Gauss-Newton step
+    // (variable projection), then discarded; the next iteration
+    // re-triangulates them from the new poses.
     std::vector<Eigen::Vector4d> qs(num_images);
     std::vector<Eigen::Vector3d> cs(num_images);
     std::vector<Eigen::Vector3d> offsets(num_images, Eigen::Vector3d::Zero());
@@ -435,7 +428,7 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
     for (int i = 0; i < num_images; ++i) {
       qs[i] = poses[i].rotation.coeffs();  // x, y, z, w
       cs[i] = poses[i].Center();
-      if (fix_gauge && i == g1) {
+      if (i == g1) {
         offsets[i] = poses[g0].Center();
         scales[i] = gauge_distance;
         cs[i] = (cs[i] - offsets[i]) / scales[i];
@@ -458,20 +451,16 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
               PoseCenterAngularCost::Create(obs.ray, offsets[i], scales[i]),
               loss, qs[i].data(), cs[i].data(), xyz[p].data());
         }
-        if (implicit_points) {
-          ordering->AddElementToGroup(xyz[p].data(), 0);
-        } else {
-          ceres_problem.SetParameterBlockConstant(xyz[p].data());
-        }
+        ordering->AddElementToGroup(xyz[p].data(), 0);
       }
       for (int i = 0; i < num_images; ++i) {
         if (!ceres_problem.HasParameterBlock(qs[i].data())) continue;
         ceres_problem.SetManifold(qs[i].data(),
                                   new ceres::EigenQuaternionManifold);
-        if (fix_gauge && i == g0) {
+        if (i == g0) {
           ceres_problem.SetParameterBlockConstant(qs[i].data());
           ceres_problem.SetParameterBlockConstant(cs[i].data());
-        } else if (fix_gauge && i == g1) {
+        } else if (i == g1) {
           ceres_problem.SetManifold(cs[i].data(), new ceres::SphereManifold<3>);
         }
         ordering->AddElementToGroup(qs[i].data(), 1);
@@ -480,16 +469,9 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
       ceres::Solver::Options solver_options;
       const bool sparse = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(
           ceres::SUITE_SPARSE);
-      if (implicit_points) {
-        solver_options.linear_solver_type =
-            sparse && num_images > 50 ? ceres::SPARSE_SCHUR
-                                      : ceres::DENSE_SCHUR;
-        solver_options.linear_solver_ordering.reset(ordering);
-      } else {
-        delete ordering;
-        solver_options.linear_solver_type =
-            sparse ? ceres::SPARSE_NORMAL_CHOLESKY : ceres::DENSE_QR;
-      }
+      solver_options.linear_solver_type =
+          sparse && num_images > 50 ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
+      solver_options.linear_solver_ordering.reset(ordering);
       solver_options.max_num_iterations = options.max_num_pose_iterations;
       // Tight, but above the round-off of the cost (a tighter tolerance
       // ends in "invalid steps" at the optimum).
@@ -515,7 +497,7 @@ CameraOnlyBAResult CameraOnlyBundleAdjustment(
     }
     std::vector<CameraPose> new_poses = poses;
     for (int i = 0; i < num_images; ++i) {
-      if (fix_gauge && i == g0) continue;
+      if (i == g0) continue;
       CameraPose& pose = new_poses[i];
       pose.rotation =
           Eigen::Quaterniond(qs[i](3), qs[i](0), qs[i](1), qs[i](2))

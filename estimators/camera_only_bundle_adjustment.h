@@ -20,15 +20,13 @@
 //      with the exact log-map angular residual of angular_residual.h and
 //      rho = identity or Cauchy (scale in radians). The points are never
 //      parameters of the result: X_j(P) is the triangulation from the poses.
-//      PointHandling::kImplicit (default) treats X_j(P) as a function of the
-//      poses inside the step: every Gauss-Newton step eliminates the points
-//      by the Schur complement (variable projection: the reduced camera
-//      system of the objective in the poses only) and the optimised point
-//      values are discarded afterwards. PointHandling::kFixed holds the
-//      points constant during the step (resection only): that is the
-//      textbook resection-intersection alternation, which converges only
-//      linearly (about 2% error reduction per iteration on the 9-camera
-//      room), so it is kept for comparison, not as the default;
+//      X_j(P) is a function of the poses inside the step: every
+//      Gauss-Newton step eliminates the points by the Schur complement
+//      (variable projection: the reduced camera system of the objective in
+//      the poses only) and the optimised point values are discarded
+//      afterwards. Holding the points constant instead (the textbook
+//      resection-intersection alternation) converges only linearly, about
+//      2% error reduction per iteration on the 9-camera room;
 //   4. optionally let a caller-supplied step refine intrinsics and re-lift the
 //      rays (this header knows only rays, not pixels);
 //   5. stop when the relative change of the cost is <= function_tolerance,
@@ -38,15 +36,14 @@
 //
 // Gauge
 // -----
-// Holding the points fixed removes the similarity gauge inside one pose step,
-// but the alternation could still drift along it from one iteration to the
-// next. With GaugeFixing::kFirstTwoCameras the pose of camera gauge_image0
+// The objective is invariant under a similarity of all poses (the points
+// follow the poses), so the gauge is fixed: the pose of camera gauge_image0
 // (default 0) is held constant and the centre of camera gauge_image1
 // (default 1) is constrained to the sphere of radius d = |C1 - C0| around C0
 // (C1 = C0 + d n, n on ceres::SphereManifold<3>), so rotation, translation and
 // scale of the input are kept: the result lives in the input's frame. In the
 // pose step every camera is parametrised by (q, C) with v = R (X - C);
-// t = -R C is written back. GaugeFixing::kNone optimises every pose.
+// t = -R C is written back.
 //
 // Failure statuses: kInvalidInput (inconsistent sizes, bad rays, bad
 // options), kTooFewObservations (an image observes fewer than
@@ -112,18 +109,7 @@ enum class CameraOnlyBAStatus {
 };
 const char* CameraOnlyBAStatusName(CameraOnlyBAStatus status);
 
-enum class GaugeFixing {
-  kFirstTwoCameras,  // pose of gauge_image0 fixed, |C(gauge_image1) - C0| fixed
-  kNone,             // every pose free
-};
-
 enum class CameraOnlyBALoss { kNone, kCauchy };
-
-// How the re-triangulated reliable points enter the pose step (see header).
-enum class PointHandling {
-  kImplicit,  // functions of the poses: Schur-eliminated, then discarded
-  kFixed,     // constants: plain resection (alternation, slow convergence)
-};
 
 struct CameraOnlyBAOptions {
   // Reliability threshold tau per image [rad]: tau_rad_fn (if set) takes
@@ -139,8 +125,7 @@ struct CameraOnlyBAOptions {
   CameraOnlyBALoss loss = CameraOnlyBALoss::kNone;
   double loss_scale_rad = 1e-3;     // Cauchy scale [rad]
 
-  PointHandling points = PointHandling::kImplicit;
-  GaugeFixing gauge = GaugeFixing::kFirstTwoCameras;
+  // Gauge: pose of gauge_image0 fixed, |C(gauge_image1) - C0| fixed.
   int gauge_image0 = 0;
   int gauge_image1 = 1;
 

@@ -57,21 +57,6 @@ std::optional<Eigen::Vector3d> TriangulateRays(
   return X;
 }
 
-std::optional<Eigen::Vector3d> TriangulateTwoRays(
-    const Eigen::Matrix3x4d& cam2_from_cam1, const Eigen::Vector3d& ray1,
-    const Eigen::Vector3d& ray2) {
-  const std::vector<Eigen::Matrix3x4d> cams = {Eigen::Matrix3x4d::Identity(),
-                                               cam2_from_cam1};
-  const std::vector<Eigen::Vector3d> rays = {ray1, ray2};
-  return TriangulateRays(cams, rays);
-}
-
-double TriangulationAngle(const Eigen::Vector3d& proj_center1,
-                          const Eigen::Vector3d& proj_center2,
-                          const Eigen::Vector3d& point3D) {
-  return AngleBetweenRays(proj_center1 - point3D, proj_center2 - point3D);
-}
-
 Eigen::Vector3d ProjectionCenter(const Eigen::Matrix3x4d& cam_from_world) {
   return -cam_from_world.leftCols<3>().transpose() * cam_from_world.col(3);
 }
@@ -120,30 +105,6 @@ bool RefineTriangulatedPoint(
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   return summary.IsSolutionUsable() && point3D->allFinite();
-}
-
-void RayTriangulationEstimator::Estimate(
-    const std::vector<X_t>& rays, const std::vector<Y_t>& cams_from_world,
-    std::vector<M_t>* models) {
-  models->clear();
-  const std::optional<Eigen::Vector3d> X = TriangulateRays(cams_from_world, rays);
-  if (X) models->push_back(*X);
-}
-
-void RayTriangulationEstimator::Residuals(
-    const std::vector<X_t>& rays, const std::vector<Y_t>& cams_from_world,
-    const M_t& point3D, std::vector<double>* residuals) {
-  residuals->resize(rays.size());
-  for (size_t i = 0; i < rays.size(); ++i) {
-    const Eigen::Vector3d v =
-        cams_from_world[i].leftCols<3>() * point3D + cams_from_world[i].col(3);
-    if (rays[i].dot(v) <= 0) {
-      (*residuals)[i] = std::numeric_limits<double>::max();
-    } else {
-      const double angle = AngleBetweenRays(rays[i], v);
-      (*residuals)[i] = angle * angle;
-    }
-  }
 }
 
 }  // namespace sphera

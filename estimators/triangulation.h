@@ -31,19 +31,6 @@ std::optional<Eigen::Vector3d> TriangulateRays(
     const std::vector<Eigen::Matrix3x4d>& cams_from_world,
     const std::vector<Eigen::Vector3d>& rays);
 
-// Two-view convenience: cam1 = [I | 0], cam2 = cam2_from_cam1.  The point is
-// returned in the frame of camera 1.
-std::optional<Eigen::Vector3d> TriangulateTwoRays(
-    const Eigen::Matrix3x4d& cam2_from_cam1, const Eigen::Vector3d& ray1,
-    const Eigen::Vector3d& ray2);
-
-// Angle [rad] at the point between the two viewing directions towards the
-// camera centres (same meaning as COLMAP's CalculateTriangulationAngle):
-//   alpha = angle(center1 - X, center2 - X).
-double TriangulationAngle(const Eigen::Vector3d& proj_center1,
-                          const Eigen::Vector3d& proj_center2,
-                          const Eigen::Vector3d& point3D);
-
 // Camera centre of cam_from_world = [R | t]:  C = -R^T t.
 Eigen::Vector3d ProjectionCenter(const Eigen::Matrix3x4d& cam_from_world);
 
@@ -70,24 +57,5 @@ bool RefineTriangulatedPoint(
     const std::vector<Eigen::Matrix3x4d>& cams_from_world,
     const std::vector<Eigen::Vector3d>& rays, Eigen::Vector3d* point3D,
     int max_num_iterations = 50);
-
-// RANSAC estimator (COLMAP concept) for multi-view triangulation.
-//   X_t: unit ray in the camera,  Y_t: cam_from_world of that camera,
-//   M_t: world point.  Residual = squared angle [rad^2]; an observation whose
-//   point is behind the ray gets residual max double.
-class RayTriangulationEstimator {
- public:
-  typedef Eigen::Vector3d X_t;
-  typedef Eigen::Matrix3x4d Y_t;
-  typedef Eigen::Vector3d M_t;
-  static constexpr int kMinNumSamples = 2;
-
-  static void Estimate(const std::vector<X_t>& rays,
-                       const std::vector<Y_t>& cams_from_world,
-                       std::vector<M_t>* models);
-  static void Residuals(const std::vector<X_t>& rays,
-                        const std::vector<Y_t>& cams_from_world,
-                        const M_t& point3D, std::vector<double>* residuals);
-};
 
 }  // namespace sphera

@@ -414,7 +414,6 @@ bool RunCameraOnly(const Options& options,
     ba.loss = sphera::CameraOnlyBALoss::kCauchy;
     ba.loss_scale_rad = sum / std::max<size_t>(1, cameras.size());
   }
-  ba.gauge = sphera::GaugeFixing::kFirstTwoCameras;
   ba.gauge_image0 = 0;
   ba.gauge_image1 = 1;
 
