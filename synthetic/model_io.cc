@@ -323,38 +323,59 @@ std::vector<GroundTruthPoint> SamplePoints(const Scene& scene,
   return points;
 }
 
-std::string WriteDataset(const std::string& output_dir, const Scene& scene,
-                         const std::vector<VirtualCamera>& cameras,
-                         const DatasetOptions& options, std::ostream* log) {
+namespace {
+
+// The stages of WriteDataset: check the inputs, open the staging directory,
+// render every image through its lens and sensor and write it, sample the
+// ground-truth points, write the model, move the staging directory in place.
+
+std::string CheckDatasetInputs(const Scene& scene, const std::vector<VirtualCamera>& cameras,
+                               const DatasetOptions& options) {
   std::string error = CheckCameras(scene, cameras);
   if (error.empty()) error = options.render.Check();
   if (error.empty()) error = scene.Options().Check();
+  if (error.empty()) error = options.effects.Check();
   if (!error.empty()) return error;
   if (options.num_points < 0) return "--points must be >= 0";
-  if (options.rig != nullptr) {
-    const RigGroundTruth& rig = *options.rig;
-    const size_t num_sensors = rig.sensor_names.size();
-    if (num_sensors == 0 || rig.sensor_from_rig_rotation.size() != num_sensors ||
-        rig.sensor_from_rig_translation.size() != num_sensors ||
-        rig.rig_from_world_rotation.size() != rig.rig_from_world_translation.size() ||
-        rig.image_sensor.size() != cameras.size() || rig.image_frame.size() != cameras.size()) {
-      return "inconsistent rig description";
-    }
-    for (size_t i = 0; i < cameras.size(); ++i) {
-      if (rig.image_sensor[i] < 0 || rig.image_sensor[i] >= static_cast<int>(num_sensors) ||
-          rig.image_frame[i] < 0 ||
-          rig.image_frame[i] >= static_cast<int>(rig.rig_from_world_rotation.size())) {
-        return "camera '" + cameras[i].name + "': sensor or frame out of range";
-      }
+  if (options.rig == nullptr) return "";
+  const RigGroundTruth& rig = *options.rig;
+  const size_t num_sensors = rig.sensor_names.size();
+  if (num_sensors == 0 || rig.sensor_from_rig_rotation.size() != num_sensors ||
+      rig.sensor_from_rig_translation.size() != num_sensors ||
+      rig.rig_from_world_rotation.size() != rig.rig_from_world_translation.size() ||
+      rig.image_sensor.size() != cameras.size() || rig.image_frame.size() != cameras.size()) {
+    return "inconsistent rig description";
+  }
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    if (rig.image_sensor[i] < 0 || rig.image_sensor[i] >= static_cast<int>(num_sensors) ||
+        rig.image_frame[i] < 0 ||
+        rig.image_frame[i] >= static_cast<int>(rig.rig_from_world_rotation.size())) {
+      return "camera '" + cameras[i].name + "': sensor or frame out of range";
     }
   }
+  return "";
+}
 
+// A dataset is written into `tmp` and renamed to `dir` when complete.
+struct Staging {
+  fs::path dir;
+  fs::path tmp;
+  bool dir_exists = false;
+};
+
+bool WritesMask(const VirtualCamera& camera, const DatasetOptions& options) {
+  return options.write_masks || LensCircle(camera, options.effects).z() > 0;
+}
+
+std::string OpenStaging(const std::string& output_dir, const std::vector<VirtualCamera>& cameras,
+                        const DatasetOptions& options, std::ostream* log, Staging* staging) {
   fs::path dir(output_dir);
   if (dir.empty()) return "no output directory given";
   if (!dir.has_filename()) dir = dir.parent_path();  // strip a trailing slash
   std::error_code ec;
-  const bool dir_exists = fs::exists(dir, ec);
-  if (dir_exists) {
+  staging->dir = dir;
+  staging->dir_exists = fs::exists(dir, ec);
+  if (staging->dir_exists) {
     if (!fs::is_directory(dir, ec)) return "output " + dir.string() + " exists and is not a directory";
     if (!fs::is_empty(dir, ec)) {
       return "refusing to overwrite non-empty output directory " + dir.string() +
@@ -362,67 +383,80 @@ std::string WriteDataset(const std::string& output_dir, const Scene& scene,
     }
   }
   const fs::path tmp = dir.string() + ".tmp";
+  staging->tmp = tmp;
   if (fs::exists(tmp, ec)) {
     if (log) *log << "removing stale staging directory " << tmp.string() << "\n";
     fs::remove_all(tmp, ec);
     if (ec) return "cannot remove stale staging directory " + tmp.string() + ": " + ec.message();
   }
-  auto fail = [&](const std::string& message) {
-    std::error_code ignored;
-    fs::remove_all(tmp, ignored);
-    return message;
-  };
   for (const char* sub : {"images", "depth", "sparse_gt"}) {
     fs::create_directories(tmp / sub, ec);
-    if (ec) return fail("cannot create " + (tmp / sub).string() + ": " + ec.message());
+    if (ec) return "cannot create " + (tmp / sub).string() + ": " + ec.message();
   }
   for (const VirtualCamera& camera : cameras) {
     const fs::path folder = fs::path(camera.name).parent_path();
     if (folder.empty()) continue;
     for (const char* sub : {"images", "depth", "masks"}) {
-      if (std::string(sub) == "masks" && camera.image_circle.z() <= 0) continue;
+      if (std::string(sub) == "masks" && !WritesMask(camera, options)) continue;
       fs::create_directories(tmp / sub / folder, ec);
-      if (ec) return fail("cannot create " + (tmp / sub / folder).string() + ": " + ec.message());
+      if (ec) return "cannot create " + (tmp / sub / folder).string() + ": " + ec.message();
     }
   }
+  return "";
+}
 
-  // Render.
+std::string CloseStaging(const Staging& staging) {
+  std::error_code ec;
+  if (staging.dir_exists) {
+    fs::remove(staging.dir, ec);  // empty, checked by OpenStaging
+    if (ec) return "cannot replace empty directory " + staging.dir.string() + ": " + ec.message();
+  }
+  fs::rename(staging.tmp, staging.dir, ec);
+  if (ec) {
+    return "cannot rename " + staging.tmp.string() + " to " + staging.dir.string() + ": " +
+           ec.message();
+  }
+  return "";
+}
+
+// Writer stage: one image (8-bit BGR) in the format its name asks for.
+std::string WriteImage(const fs::path& path, const cv::Mat& image, int jpeg_quality) {
+  bool ok = false;
+  try {
+    ok = cv::imwrite(path.string(), image, ImageWriteParams(path.string(), jpeg_quality));
+  } catch (const cv::Exception& e) {
+    return "cannot write " + path.string() + ": " + e.what();
+  }
+  return ok ? "" : "cannot write " + path.string();
+}
+
+// Scene, lens projection and sensor stages for every camera, each image
+// written as soon as it is done (a dataset does not fit in memory).
+std::string RenderAndWriteImages(const fs::path& tmp, const Scene& scene,
+                                 const std::vector<VirtualCamera>& cameras,
+                                 const DatasetOptions& options, std::ostream* log) {
   for (size_t i = 0; i < cameras.size(); ++i) {
     const VirtualCamera& camera = cameras[i];
     const auto start = std::chrono::steady_clock::now();
-    RenderOptions render_options = options.render;
-    render_options.noise_seed = options.render.noise_seed * 1000003ULL + i;
-    const RenderedImage rendered = Render(scene, camera, render_options);
-    const fs::path image_path = tmp / "images" / camera.name;
-    std::vector<int> write_params;
-    if (IsPng(camera.name)) {
-      write_params = {cv::IMWRITE_PNG_COMPRESSION, 3};
-    } else {
-      write_params = {cv::IMWRITE_JPEG_QUALITY, 95};
-    }
-    bool ok = false;
-    try {
-      ok = cv::imwrite(image_path.string(), rendered.image, write_params);
-    } catch (const cv::Exception& e) {
-      return fail("cannot write " + image_path.string() + ": " + e.what());
-    }
-    if (!ok) return fail("cannot write " + image_path.string());
-    if (camera.image_circle.z() > 0) {
-      cv::Mat mask(camera.height, camera.width, CV_8U);
-      for (int row = 0; row < camera.height; ++row) {
-        for (int col = 0; col < camera.width; ++col) {
-          mask.at<uint8_t>(row, col) = camera.InImageCircle(col, row) ? 255 : 0;
-        }
-      }
+    const RenderedImage rendered = Render(scene, camera, options.render);
+    // In a rig every lens (sensor) has its own response; else every image.
+    const int lens_index = options.rig ? options.rig->image_sensor[i] : static_cast<int>(i);
+    const cv::Mat image =
+        ApplySensorEffects(rendered.radiance, camera, options.effects, lens_index, i);
+    std::string error = WriteImage(tmp / "images" / camera.name, image,
+                                   options.effects.jpeg_quality);
+    if (!error.empty()) return error;
+    if (WritesMask(camera, options)) {
       const fs::path mask_path = tmp / "masks" / (camera.name + ".png");
+      std::error_code ec;
       fs::create_directories(mask_path.parent_path(), ec);
-      if (ec || !cv::imwrite(mask_path.string(), mask)) {
-        return fail("cannot write " + mask_path.string());
+      if (ec || !cv::imwrite(mask_path.string(), ValidPixelMask(camera, options.effects))) {
+        return "cannot write " + mask_path.string();
       }
     }
     const fs::path depth_path = tmp / "depth" / (camera.name + ".depth.bin");
     if (!WriteDepthMap(depth_path.string(), rendered.depth)) {
-      return fail("cannot write " + depth_path.string());
+      return "cannot write " + depth_path.string();
     }
     if (log) {
       const double seconds =
@@ -434,150 +468,222 @@ std::string WriteDataset(const std::string& output_dir, const Scene& scene,
       log->flush();
     }
   }
+  return "";
+}
 
-  // Cameras: identical intrinsics share one camera id; in a rig, every
-  // sensor is its own camera (id = sensor index + 1).
+// Camera ids per image and cameras.txt: identical intrinsics share one
+// camera id; in a rig, every sensor is its own camera (id = sensor index + 1).
+std::vector<int> AssignCameraIds(const std::vector<VirtualCamera>& cameras,
+                                 const RigGroundTruth* rig, std::string* cameras_txt) {
   std::map<std::string, int> camera_ids;
   std::vector<int> image_camera_id(cameras.size());
-  std::ostringstream cameras_txt;
-  cameras_txt << "# Camera list with one line of data per camera:\n"
-              << "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n";
+  std::ostringstream text;
+  text << "# Camera list with one line of data per camera:\n"
+       << "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n";
   for (size_t i = 0; i < cameras.size(); ++i) {
     const VirtualCamera& camera = cameras[i];
     const std::string intrinsics = camera.model_name + " " + std::to_string(camera.width) + " " +
                                    std::to_string(camera.height) + " " + Join(camera.params);
-    const std::string key =
-        options.rig ? std::to_string(options.rig->image_sensor[i]) : intrinsics;
+    const std::string key = rig ? std::to_string(rig->image_sensor[i]) : intrinsics;
     auto it = camera_ids.find(key);
     if (it == camera_ids.end()) {
-      const int id = options.rig ? options.rig->image_sensor[i] + 1
-                                 : static_cast<int>(camera_ids.size()) + 1;
+      const int id = rig ? rig->image_sensor[i] + 1 : static_cast<int>(camera_ids.size()) + 1;
       it = camera_ids.emplace(key, id).first;
-      cameras_txt << it->second << " " << intrinsics << "\n";
+      text << it->second << " " << intrinsics << "\n";
     }
     image_camera_id[i] = it->second;
   }
+  *cameras_txt = text.str();
+  return image_camera_id;
+}
 
-  const std::vector<GroundTruthPoint> points =
-      options.num_points > 0 ? SamplePoints(scene, cameras, options.num_points, options.points_seed)
-                             : std::vector<GroundTruthPoint>();
-  // Per image, its observations (point index, pixel) in order: POINT2D_IDX.
-  std::vector<std::vector<std::pair<int, Eigen::Vector2d>>> image_points(cameras.size());
-  std::vector<std::vector<std::pair<int, int>>> tracks(points.size());
+// The points' observations in COLMAP's cross-referenced form.
+struct ObservationIndex {
+  // Per image, its observations (POINT3D_ID, pixel) in POINT2D_IDX order.
+  std::vector<std::vector<std::pair<int, Eigen::Vector2d>>> image_points;
+  // Per point, its track (IMAGE_ID, POINT2D_IDX).
+  std::vector<std::vector<std::pair<int, int>>> tracks;
+};
+
+ObservationIndex IndexObservations(const std::vector<GroundTruthPoint>& points,
+                                   size_t num_images) {
+  ObservationIndex index;
+  index.image_points.resize(num_images);
+  index.tracks.resize(points.size());
   for (size_t p = 0; p < points.size(); ++p) {
     for (const PointObservation& obs : points[p].observations) {
-      tracks[p].emplace_back(obs.image_index + 1,
-                             static_cast<int>(image_points[obs.image_index].size()));
-      image_points[obs.image_index].emplace_back(static_cast<int>(p) + 1, obs.pixel);
+      index.tracks[p].emplace_back(obs.image_index + 1,
+                                   static_cast<int>(index.image_points[obs.image_index].size()));
+      index.image_points[obs.image_index].emplace_back(static_cast<int>(p) + 1, obs.pixel);
     }
   }
+  return index;
+}
 
-  std::ostringstream images_txt;
-  images_txt << std::setprecision(17);
-  images_txt << "# Image list with two lines of data per image:\n"
-             << "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
-             << "#   POINTS2D[] as (X, Y, POINT3D_ID)\n";
-  std::ostringstream rig_txt;
-  rig_txt << std::setprecision(17);
-  rig_txt << "# NAME MODEL WIDTH HEIGHT PARAMS... | QW QX QY QZ TX TY TZ (cam_from_world)\n";
+std::string ImagesText(const std::vector<VirtualCamera>& cameras,
+                       const std::vector<int>& image_camera_id, const ObservationIndex& index) {
+  std::ostringstream text;
+  text << std::setprecision(17);
+  text << "# Image list with two lines of data per image:\n"
+       << "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
+       << "#   POINTS2D[] as (X, Y, POINT3D_ID)\n";
   for (size_t i = 0; i < cameras.size(); ++i) {
     const VirtualCamera& camera = cameras[i];
     const Eigen::Quaterniond& q = camera.cam_from_world_rotation;
     const Eigen::Vector3d& t = camera.cam_from_world_translation;
-    images_txt << i + 1 << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " "
-               << t.x() << " " << t.y() << " " << t.z() << " " << image_camera_id[i] << " "
-               << camera.name << "\n";
-    for (size_t k = 0; k < image_points[i].size(); ++k) {
-      images_txt << (k ? " " : "") << image_points[i][k].second.x() << " "
-                 << image_points[i][k].second.y() << " " << image_points[i][k].first;
+    text << i + 1 << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " " << t.x()
+         << " " << t.y() << " " << t.z() << " " << image_camera_id[i] << " " << camera.name
+         << "\n";
+    const auto& observations = index.image_points[i];
+    for (size_t k = 0; k < observations.size(); ++k) {
+      text << (k ? " " : "") << observations[k].second.x() << " " << observations[k].second.y()
+           << " " << observations[k].first;
     }
-    images_txt << "\n";
-    rig_txt << camera.name << " " << camera.model_name << " " << camera.width << " "
-            << camera.height << " " << Join(camera.params) << " | " << q.w() << " " << q.x()
-            << " " << q.y() << " " << q.z() << " " << t.x() << " " << t.y() << " " << t.z()
-            << "\n";
+    text << "\n";
   }
+  return text.str();
+}
 
-  std::ostringstream points_txt;
-  points_txt << std::setprecision(17);
-  points_txt << "# 3D point list with one line of data per point:\n"
-             << "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n";
+std::string RigFileText(const std::vector<VirtualCamera>& cameras) {
+  std::ostringstream text;
+  text << std::setprecision(17);
+  text << "# NAME MODEL WIDTH HEIGHT PARAMS... | QW QX QY QZ TX TY TZ (cam_from_world)\n";
+  for (const VirtualCamera& camera : cameras) {
+    const Eigen::Quaterniond& q = camera.cam_from_world_rotation;
+    const Eigen::Vector3d& t = camera.cam_from_world_translation;
+    text << camera.name << " " << camera.model_name << " " << camera.width << " "
+         << camera.height << " " << Join(camera.params) << " | " << q.w() << " " << q.x() << " "
+         << q.y() << " " << q.z() << " " << t.x() << " " << t.y() << " " << t.z() << "\n";
+  }
+  return text.str();
+}
+
+std::string PointsText(const std::vector<GroundTruthPoint>& points, const ObservationIndex& index) {
+  std::ostringstream text;
+  text << std::setprecision(17);
+  text << "# 3D point list with one line of data per point:\n"
+       << "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n";
   for (size_t p = 0; p < points.size(); ++p) {
     const GroundTruthPoint& point = points[p];
-    points_txt << p + 1 << " " << point.xyz.x() << " " << point.xyz.y() << " " << point.xyz.z()
-               << " " << point.rgb.x() << " " << point.rgb.y() << " " << point.rgb.z() << " 0";
-    for (const auto& [image_id, point2d_idx] : tracks[p]) {
-      points_txt << " " << image_id << " " << point2d_idx;
+    text << p + 1 << " " << point.xyz.x() << " " << point.xyz.y() << " " << point.xyz.z() << " "
+         << point.rgb.x() << " " << point.rgb.y() << " " << point.rgb.z() << " 0";
+    for (const auto& [image_id, point2d_idx] : index.tracks[p]) {
+      text << " " << image_id << " " << point2d_idx;
     }
-    points_txt << "\n";
+    text << "\n";
   }
+  return text.str();
+}
 
+// COLMAP 4 text: sensor type CAMERA, sensor id = camera id, data id = image id.
+std::string RigsText(const RigGroundTruth& rig) {
+  std::ostringstream text;
+  text << std::setprecision(17);
+  text << "# Rig calib list with one line of data per calib:\n"
+       << "#   RIG_ID, NUM_SENSORS, REF_SENSOR_TYPE, REF_SENSOR_ID, SENSORS[] as "
+          "(SENSOR_TYPE, SENSOR_ID, HAS_POSE, [QW, QX, QY, QZ, TX, TY, TZ])\n"
+       << "1 " << rig.sensor_names.size() << " CAMERA 1";
+  for (size_t k = 1; k < rig.sensor_names.size(); ++k) {
+    const Eigen::Quaterniond& q = rig.sensor_from_rig_rotation[k];
+    const Eigen::Vector3d& t = rig.sensor_from_rig_translation[k];
+    text << " CAMERA " << k + 1 << " 1 " << q.w() << " " << q.x() << " " << q.y() << " " << q.z()
+         << " " << t.x() << " " << t.y() << " " << t.z();
+  }
+  text << "\n";
+  return text.str();
+}
+
+std::string FramesText(const RigGroundTruth& rig, const std::vector<int>& image_camera_id) {
+  std::ostringstream text;
+  text << std::setprecision(17);
+  text << "# Frame list with one line of data per frame:\n"
+       << "#   FRAME_ID, RIG_ID, RIG_FROM_WORLD[QW, QX, QY, QZ, TX, TY, TZ], "
+          "NUM_DATA_IDS, DATA_IDS[] as (SENSOR_TYPE, SENSOR_ID, DATA_ID)\n";
+  for (size_t f = 0; f < rig.rig_from_world_rotation.size(); ++f) {
+    std::vector<size_t> members;
+    for (size_t i = 0; i < rig.image_frame.size(); ++i) {
+      if (rig.image_frame[i] == static_cast<int>(f)) members.push_back(i);
+    }
+    if (members.empty()) continue;
+    const Eigen::Quaterniond& q = rig.rig_from_world_rotation[f];
+    const Eigen::Vector3d& t = rig.rig_from_world_translation[f];
+    text << f + 1 << " 1 " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " "
+         << t.x() << " " << t.y() << " " << t.z() << " " << members.size();
+    for (const size_t i : members) text << " CAMERA " << image_camera_id[i] << " " << i + 1;
+    text << "\n";
+  }
+  return text.str();
+}
+
+// Model stage: the ground truth (sparse_gt/ and rig.txt) of the cameras and
+// points. Returns the number of distinct cameras in `num_cameras`.
+std::string WriteModel(const fs::path& tmp, const std::vector<VirtualCamera>& cameras,
+                       const std::vector<GroundTruthPoint>& points, const RigGroundTruth* rig,
+                       int* num_cameras) {
+  std::string cameras_txt;
+  const std::vector<int> image_camera_id = AssignCameraIds(cameras, rig, &cameras_txt);
+  *num_cameras = static_cast<int>(
+      std::set<int>(image_camera_id.begin(), image_camera_id.end()).size());
+  const ObservationIndex index = IndexObservations(points, cameras.size());
   std::vector<std::pair<fs::path, std::string>> texts = {
-      {tmp / "sparse_gt" / "cameras.txt", cameras_txt.str()},
-      {tmp / "sparse_gt" / "images.txt", images_txt.str()},
-      {tmp / "sparse_gt" / "points3D.txt", points_txt.str()},
-      {tmp / "rig.txt", rig_txt.str()},
+      {tmp / "sparse_gt" / "cameras.txt", cameras_txt},
+      {tmp / "sparse_gt" / "images.txt", ImagesText(cameras, image_camera_id, index)},
+      {tmp / "sparse_gt" / "points3D.txt", PointsText(points, index)},
+      {tmp / "rig.txt", RigFileText(cameras)},
   };
-  if (options.rig != nullptr) {
-    const RigGroundTruth& rig = *options.rig;
-    // COLMAP 4 text: sensor type CAMERA, sensor id = camera id, data id =
-    // image id.
-    std::ostringstream rigs_txt, frames_txt;
-    rigs_txt << std::setprecision(17);
-    frames_txt << std::setprecision(17);
-    rigs_txt << "# Rig calib list with one line of data per calib:\n"
-             << "#   RIG_ID, NUM_SENSORS, REF_SENSOR_TYPE, REF_SENSOR_ID, SENSORS[] as "
-                "(SENSOR_TYPE, SENSOR_ID, HAS_POSE, [QW, QX, QY, QZ, TX, TY, TZ])\n"
-             << "1 " << rig.sensor_names.size() << " CAMERA 1";
-    for (size_t k = 1; k < rig.sensor_names.size(); ++k) {
-      const Eigen::Quaterniond& q = rig.sensor_from_rig_rotation[k];
-      const Eigen::Vector3d& t = rig.sensor_from_rig_translation[k];
-      rigs_txt << " CAMERA " << k + 1 << " 1 " << q.w() << " " << q.x() << " " << q.y() << " "
-               << q.z() << " " << t.x() << " " << t.y() << " " << t.z();
-    }
-    rigs_txt << "\n";
-    frames_txt << "# Frame list with one line of data per frame:\n"
-               << "#   FRAME_ID, RIG_ID, RIG_FROM_WORLD[QW, QX, QY, QZ, TX, TY, TZ], "
-                  "NUM_DATA_IDS, DATA_IDS[] as (SENSOR_TYPE, SENSOR_ID, DATA_ID)\n";
-    for (size_t f = 0; f < rig.rig_from_world_rotation.size(); ++f) {
-      std::vector<size_t> members;
-      for (size_t i = 0; i < cameras.size(); ++i) {
-        if (rig.image_frame[i] == static_cast<int>(f)) members.push_back(i);
-      }
-      if (members.empty()) continue;
-      const Eigen::Quaterniond& q = rig.rig_from_world_rotation[f];
-      const Eigen::Vector3d& t = rig.rig_from_world_translation[f];
-      frames_txt << f + 1 << " 1 " << q.w() << " " << q.x() << " " << q.y() << " " << q.z()
-                 << " " << t.x() << " " << t.y() << " " << t.z() << " " << members.size();
-      for (const size_t i : members) {
-        frames_txt << " CAMERA " << image_camera_id[i] << " " << i + 1;
-      }
-      frames_txt << "\n";
-    }
-    texts.emplace_back(tmp / "sparse_gt" / "rigs.txt", rigs_txt.str());
-    texts.emplace_back(tmp / "sparse_gt" / "frames.txt", frames_txt.str());
+  if (rig != nullptr) {
+    texts.emplace_back(tmp / "sparse_gt" / "rigs.txt", RigsText(*rig));
+    texts.emplace_back(tmp / "sparse_gt" / "frames.txt", FramesText(*rig, image_camera_id));
   }
   for (const auto& [path, text] : texts) {
     std::ofstream file(path);
     file << text;
     file.close();
-    if (!file) return fail("cannot write " + path.string());
+    if (!file) return "cannot write " + path.string();
   }
+  return "";
+}
+
+}  // namespace
+
+std::vector<int> ImageWriteParams(const std::string& name, int jpeg_quality) {
+  if (IsPng(name)) return {cv::IMWRITE_PNG_COMPRESSION, 3};
+  return {cv::IMWRITE_JPEG_QUALITY, jpeg_quality > 0 ? jpeg_quality : 95};
+}
+
+std::string WriteDataset(const std::string& output_dir, const Scene& scene,
+                         const std::vector<VirtualCamera>& cameras,
+                         const DatasetOptions& options, std::ostream* log) {
+  std::string error = CheckDatasetInputs(scene, cameras, options);
+  if (!error.empty()) return error;
+  Staging staging;
+  error = OpenStaging(output_dir, cameras, options, log, &staging);
+  auto fail = [&](const std::string& message) {
+    std::error_code ignored;
+    if (!staging.tmp.empty()) fs::remove_all(staging.tmp, ignored);
+    return message;
+  };
+  if (!error.empty()) return fail(error);
+
+  error = RenderAndWriteImages(staging.tmp, scene, cameras, options, log);
+  if (!error.empty()) return fail(error);
+
+  const std::vector<GroundTruthPoint> points =
+      options.num_points > 0 ? SamplePoints(scene, cameras, options.num_points, options.points_seed)
+                             : std::vector<GroundTruthPoint>();
+  int num_cameras = 0;
+  error = WriteModel(staging.tmp, cameras, points, options.rig, &num_cameras);
+  if (!error.empty()) return fail(error);
 
   if (options.extra) {
-    const std::string extra_error = options.extra(tmp.string(), log);
-    if (!extra_error.empty()) return fail(extra_error);
+    error = options.extra(staging.tmp.string(), log);
+    if (!error.empty()) return fail(error);
   }
-
-  if (dir_exists) {
-    fs::remove(dir, ec);  // empty, checked above
-    if (ec) return fail("cannot replace empty directory " + dir.string() + ": " + ec.message());
-  }
-  fs::rename(tmp, dir, ec);
-  if (ec) return fail("cannot rename " + tmp.string() + " to " + dir.string() + ": " + ec.message());
+  error = CloseStaging(staging);
+  if (!error.empty()) return fail(error);
   if (log) {
-    *log << "wrote " << cameras.size() << " images, " << camera_ids.size() << " camera(s), "
-         << points.size() << " points to " << dir.string() << "\n";
+    *log << "wrote " << cameras.size() << " images, " << num_cameras << " camera(s), "
+         << points.size() << " points to " << staging.dir.string() << "\n";
   }
   return "";
 }

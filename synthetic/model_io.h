@@ -2,14 +2,17 @@
 // COLMAP's text format.
 //
 // Dataset layout (DIR is written as DIR.tmp, then renamed):
-//   DIR/images/NAME                    rendered 8-bit JPEG (quality 95) or PNG
+//   DIR/images/NAME                    rendered 8-bit JPEG (quality 95 unless the sensor
+//                                      effects set one) or PNG
 //   DIR/depth/NAME.depth.bin           range map, see WriteDepthMap (render.h)
 //   DIR/sparse_gt/cameras.txt          CAMERA_ID MODEL WIDTH HEIGHT PARAMS[] (model names)
 //   DIR/sparse_gt/images.txt           IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME, then
 //                                      POINTS2D[] as (X, Y, POINT3D_ID) (empty without points)
 //   DIR/sparse_gt/points3D.txt         POINT3D_ID X Y Z R G B ERROR TRACK[] (IMAGE_ID, POINT2D_IDX)
 //   DIR/rig.txt                        the cameras in rig-file format (reproducible input)
-//   DIR/masks/NAME.png                 for cameras with an image circle: 255 inside it
+//   DIR/masks/NAME.png                 for cameras with an image circle (their own or the
+//                                      sensor effects'), or every camera with write_masks:
+//                                      255 where the pixel sees the scene (ValidPixelMask)
 //   DIR/sparse_gt/{rigs,frames}.txt    for a rig (DatasetOptions::rig), COLMAP 4 text
 // Poses are cam_from_world (COLMAP). Pixels: upper-left image corner is (0, 0).
 //
@@ -29,6 +32,7 @@
 
 #include "synthetic/render.h"
 #include "synthetic/scene.h"
+#include "synthetic/sensor_effects.h"
 
 namespace sphera {
 namespace synthetic {
@@ -109,6 +113,11 @@ struct RigGroundTruth {
 
 struct DatasetOptions {
   RenderOptions render;
+  // Applied to every image after the lens projection; they change pixels
+  // only, never the ground truth. In a rig each sensor is one lens.
+  SensorEffects effects;
+  // Write DIR/masks/NAME.png for every camera, not only those with a circle.
+  bool write_masks = false;
   int num_points = 0;
   uint64_t points_seed = 0;
   // Set for a rig: one camera per sensor, rigs.txt and frames.txt.
@@ -117,6 +126,10 @@ struct DatasetOptions {
   // into place; returns an error message or "".
   std::function<std::string(const std::string& staging_dir, std::ostream* log)> extra;
 };
+
+// cv::imwrite parameters for an image named `name`: PNG (compression 3) or
+// JPEG at `jpeg_quality` (0: 95).
+std::vector<int> ImageWriteParams(const std::string& name, int jpeg_quality);
 
 // Renders every camera and writes the dataset into `output_dir` atomically
 // (via output_dir + ".tmp"). Refuses an existing non-empty `output_dir`.

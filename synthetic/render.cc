@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <random>
 #include <sstream>
 #include <thread>
 
@@ -113,8 +112,6 @@ std::string RenderOptions::Check() const {
   std::ostringstream error;
   if (supersample < 1 || supersample > 16) {
     error << "supersample must be in [1, 16] (got " << supersample << ")";
-  } else if (!(noise_sigma >= 0) || !std::isfinite(noise_sigma)) {
-    error << "noise_sigma must be >= 0 (got " << noise_sigma << ")";
   } else if (num_threads < 0) {
     error << "num_threads must be >= 0 (got " << num_threads << ")";
   }
@@ -125,7 +122,7 @@ RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
                      const RenderOptions& options) {
   const int width = camera.width, height = camera.height;
   RenderedImage out;
-  out.image.create(height, width, CV_8UC3);
+  out.radiance.create(height, width, CV_64FC3);
   out.depth.create(height, width, CV_32F);
 
   const Eigen::Matrix3d world_from_cam = camera.cam_from_world_rotation.conjugate().toRotationMatrix();
@@ -214,14 +211,12 @@ RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
   };
 
   auto render_row = [&](int row) {
-    std::mt19937_64 rng(options.noise_seed * 0x9e3779b97f4a7c15ULL + static_cast<uint64_t>(row));
-    std::normal_distribution<double> noise(0.0, 1.0);
-    cv::Vec3b* image_row = out.image.ptr<cv::Vec3b>(row);
+    cv::Vec3d* radiance_row = out.radiance.ptr<cv::Vec3d>(row);
     float* depth_row = out.depth.ptr<float>(row);
     for (int col = 0; col < width; ++col) {
       if (!camera.InImageCircle(col, row)) {
         depth_row[col] = 0;
-        image_row[col] = cv::Vec3b(0, 0, 0);
+        radiance_row[col] = cv::Vec3d(0, 0, 0);
         continue;
       }
       // Pixel (col, row) covers [col, col+1] x [row, row+1]; its centre is
@@ -253,12 +248,8 @@ RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
         if (!trace(Eigen::Vector2d(col + 0.5, row + 0.5), &colour, &centre_range)) centre_range = 0;
       }
       depth_row[col] = static_cast<float>(centre_range);
-      for (int c = 0; c < 3; ++c) {
-        double value = 255.0 * sum[c] * inv_samples;
-        if (options.noise_sigma > 0) value += options.noise_sigma * noise(rng);
-        // OpenCV stores BGR.
-        image_row[col][2 - c] = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
-      }
+      // OpenCV stores BGR.
+      for (int c = 0; c < 3; ++c) radiance_row[col][2 - c] = 255.0 * sum[c] * inv_samples;
     }
   };
 
@@ -274,7 +265,21 @@ RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
   for (int t = 1; t < num_threads; ++t) threads.emplace_back(worker);
   worker();
   for (std::thread& thread : threads) thread.join();
+  out.image = ToEightBit(out.radiance);
   return out;
+}
+
+cv::Mat ToEightBit(const cv::Mat& radiance) {
+  cv::Mat image(radiance.rows, radiance.cols, CV_8UC3);
+  for (int row = 0; row < radiance.rows; ++row) {
+    const double* in = radiance.ptr<double>(row);
+    uint8_t* out = image.ptr<uint8_t>(row);
+    // std::lround rather than cv::saturate_cast, which rounds halves to even.
+    for (int i = 0; i < 3 * radiance.cols; ++i) {
+      out[i] = static_cast<uint8_t>(std::clamp(std::lround(in[i]), 0L, 255L));
+    }
+  }
+  return image;
 }
 
 bool WriteDepthMap(const std::string& path, const cv::Mat& depth) {

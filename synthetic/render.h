@@ -74,24 +74,31 @@ VirtualCamera MakeCamera(const std::string& name, const std::string& model_name,
 struct RenderOptions {
   // K x K stratified (N-rooks) sub-pixel rays per pixel, averaged (box filter).
   int supersample = 3;
-  // Standard deviation of additive Gaussian noise in 8-bit intensity levels.
-  double noise_sigma = 0;
-  uint64_t noise_seed = 0;
   // 0: all hardware threads.
   int num_threads = 0;
 
   std::string Check() const;
 };
 
+// The lens projection stage: what reaches the sensor, before any sensor
+// effect (synthetic/sensor_effects.h turns `radiance` into a recorded frame).
 struct RenderedImage {
-  cv::Mat image;  // CV_8UC3, BGR (OpenCV order), black outside the model's domain
+  // CV_64FC3, BGR (OpenCV order), the mean scene colour over the pixel's
+  // sub-pixel rays in 8-bit units (255 = white surface); 0 outside the model's
+  // domain and outside the camera's image circle.
+  cv::Mat radiance;
+  cv::Mat image;  // CV_8UC3, ToEightBit(radiance): the ideal, noise-free frame
   cv::Mat depth;  // CV_32F, range along the pixel-centre ray in metres, 0 if no hit
 };
 
 // Renders `camera` (which must pass Check()). Deterministic given the scene,
-// the camera and the options (including the noise seed).
+// the camera and the options.
 RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
                      const RenderOptions& options);
+
+// CV_64FC3 in 8-bit units to CV_8UC3: every value rounded half away from zero
+// and clamped to [0, 255].
+cv::Mat ToEightBit(const cv::Mat& radiance);
 
 // Depth file: int32 width, int32 height, then width*height float32 ranges in
 // metres, row-major (row 0 first), all little-endian; 0 where nothing is hit.

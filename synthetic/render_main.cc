@@ -50,10 +50,30 @@ Scene and rendering:
   --checker_size M       checker square side in metres (default 0.25)
   --no_boxes             empty room without furniture
   --supersample K        K x K rays per pixel (default 3)
-  --noise_sigma S        Gaussian noise, 8-bit intensity levels (default 0)
   --points N             write up to N ground-truth 3D points with observations
   --format jpg|png       image format for generated names (default jpg)
   --num_threads T        0 = all cores (default)
+Sensor effects (see synthetic/sensor_effects.h; all off by default; they change
+pixels only, never the ground truth; in a rig every lens meters on its own):
+  --realistic            a consumer 360-camera preset: --circle_radius 1.05
+                         --housing 55 --surround 14 --vignetting 0.35 --flare 40
+                         --exposure_jitter 0.25 --white_balance_jitter 0.05
+                         --noise_sigma 2 --jpeg_quality 90; the options below
+                         override single values
+  --circle_radius R      image circle radius in half frame heights (0: none; > 1
+                         crops it at the top and bottom), centred on the frame
+                         or on a rig lens's own circle
+  --housing L            brightness (DN) of the lens housing ring outside the circle
+  --surround L           brightness (DN) beyond the housing
+  --vignetting V         fraction of light lost at the circle's rim, in [0, 1)
+  --flare L              peak brightness (DN) of a flare blob and streak per image
+  --exposure_jitter S    per-lens exposure spread in stops (standard deviation)
+  --white_balance_jitter S  per-lens red and blue gain spread in stops
+  --noise_sigma S        Gaussian read noise in DN (default 0)
+  --jpeg_quality Q       JPEG quality 1..100 (default 95; needs --format jpg)
+  --effects_seed S       seed of the effects' randomness (default: --seed)
+  --write_masks          write DIR/masks/NAME.png (255 = sees the scene) for every
+                         image; images with an image circle always get one
 )";
 
 int Fail(const std::string& message) {
@@ -86,20 +106,24 @@ bool ParseDouble(const std::string& text, double* value) {
 int main(int argc, char** argv) {
   using namespace sphera::synthetic;
   std::map<std::string, std::string> args;
-  bool no_boxes = false, raw = false, stitched = false;
+  std::map<std::string, bool> switches = {{"--no_boxes", false},   {"--raw", false},
+                                          {"--stitched", false},   {"--realistic", false},
+                                          {"--write_masks", false}};
   const std::vector<std::string> value_flags = {
       "--output", "--layout", "--num_cameras", "--model", "--width", "--height",
       "--camera_params", "--rig", "--seed", "--texture", "--checker_size", "--supersample",
       "--noise_sigma", "--points", "--format", "--num_threads", "--rig_preset", "--rig_sensors",
-      "--frames", "--lens_size", "--stitched_width", "--stitch_band_deg", "--stitch_distance"};
+      "--frames", "--lens_size", "--stitched_width", "--stitch_band_deg", "--stitch_distance",
+      "--circle_radius", "--housing", "--surround", "--vignetting", "--flare",
+      "--exposure_jitter", "--white_balance_jitter", "--jpeg_quality", "--effects_seed"};
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
     if (flag == "--help" || flag == "-h") {
       std::cout << kUsage;
       return 0;
     }
-    if (flag == "--no_boxes" || flag == "--raw" || flag == "--stitched") {
-      (flag == "--no_boxes" ? no_boxes : flag == "--raw" ? raw : stitched) = true;
+    if (switches.count(flag)) {
+      switches[flag] = true;
       continue;
     }
     bool known = false;
@@ -130,17 +154,18 @@ int main(int argc, char** argv) {
     return true;
   };
 
+  const bool no_boxes = switches["--no_boxes"], raw = switches["--raw"],
+             stitched = switches["--stitched"];
   if (!args.count("--output")) return Fail("--output DIR is required (see --help)");
   long long seed, num_cameras, width, height, supersample, points, num_threads, num_frames,
       lens_size, stitched_width;
-  double noise_sigma, checker_size, stitch_band, stitch_distance;
+  double checker_size, stitch_band, stitch_distance;
   if (!get_int("--seed", 0, 0, (1LL << 62), &seed) ||
       !get_int("--num_cameras", 0, 1, 10000, &num_cameras) ||
       !get_int("--width", 0, 1, 65536, &width) || !get_int("--height", 0, 1, 65536, &height) ||
       !get_int("--supersample", 3, 1, 16, &supersample) ||
       !get_int("--points", 0, 0, 100000000, &points) ||
       !get_int("--num_threads", 0, 0, 1024, &num_threads) ||
-      !get_double("--noise_sigma", 0, &noise_sigma) ||
       !get_double("--checker_size", 0.25, &checker_size) ||
       !get_int("--frames", 10, 1, 10000, &num_frames) ||
       !get_int("--lens_size", 0, 16, 65536, &lens_size) ||
@@ -152,6 +177,33 @@ int main(int argc, char** argv) {
   const std::string format = args.count("--format") ? args["--format"] : "jpg";
   if (format != "jpg" && format != "png") return Fail("--format must be jpg or png");
   const std::string extension = "." + format;
+
+  // Sensor effects: the preset, then single values; the field names are the
+  // option names, so Check()'s message names the option.
+  SensorEffects effects = switches["--realistic"] ? SensorEffects::Realistic() : SensorEffects();
+  for (const auto& [flag, field] : std::vector<std::pair<std::string, double*>>{
+           {"--circle_radius", &effects.circle_radius},
+           {"--housing", &effects.housing},
+           {"--surround", &effects.surround},
+           {"--vignetting", &effects.vignetting},
+           {"--flare", &effects.flare},
+           {"--exposure_jitter", &effects.exposure_jitter},
+           {"--white_balance_jitter", &effects.white_balance_jitter},
+           {"--noise_sigma", &effects.noise_sigma}}) {
+    if (!get_double(flag, *field, field)) return 1;
+  }
+  long long jpeg_quality, effects_seed;
+  if (!get_int("--jpeg_quality", effects.jpeg_quality, 1, 100, &jpeg_quality) ||
+      !get_int("--effects_seed", seed, 0, (1LL << 62), &effects_seed)) {
+    return 1;
+  }
+  if (args.count("--jpeg_quality") && format != "jpg") {
+    return Fail("--jpeg_quality needs --format jpg");
+  }
+  effects.jpeg_quality = static_cast<int>(jpeg_quality);
+  effects.seed = static_cast<uint64_t>(effects_seed);
+  const std::string effects_error = effects.Check();
+  if (!effects_error.empty()) return Fail("--" + effects_error);
 
   SceneOptions scene_options;
   scene_options.seed = static_cast<uint64_t>(seed);
@@ -169,9 +221,9 @@ int main(int argc, char** argv) {
 
   DatasetOptions options;
   options.render.supersample = static_cast<int>(supersample);
-  options.render.noise_sigma = noise_sigma;
-  options.render.noise_seed = static_cast<uint64_t>(seed);
   options.render.num_threads = static_cast<int>(num_threads);
+  options.effects = effects;
+  options.write_masks = switches["--write_masks"];
   options.num_points = static_cast<int>(points);
   options.points_seed = static_cast<uint64_t>(seed);
   const auto start = std::chrono::steady_clock::now();

@@ -298,27 +298,6 @@ TEST(Render, EquirectangularDepthLiesOnTheSurfaces) {
   }
 }
 
-TEST(Render, NoiseIsDeterministicAndHasTheRequestedSigma) {
-  SceneOptions scene_options;
-  scene_options.texture = TextureKind::kChecker;
-  scene_options.checker_size_m = 10;  // one flat grey-level square
-  const Scene scene(scene_options);
-  const VirtualCamera camera =
-      MakeCamera("n.png", "PINHOLE", 100, 100, {400, 400, 50, 50}, Eigen::Matrix3d::Identity(),
-                 Eigen::Vector3d(1.0, 0.8, 0.0));
-  RenderOptions options;
-  options.supersample = 1;
-  options.noise_sigma = 4;
-  options.noise_seed = 11;
-  const RenderedImage a = Render(scene, camera, options);
-  options.num_threads = 1;
-  const RenderedImage b = Render(scene, camera, options);
-  EXPECT_EQ(cv::norm(a.image, b.image, cv::NORM_INF), 0);
-  cv::Scalar mean, stddev;
-  cv::meanStdDev(a.image, mean, stddev);
-  EXPECT_NEAR(stddev[0], 4.0, 0.3);
-}
-
 TEST(Render, DepthFileRoundTrip) {
   cv::Mat depth(3, 5, CV_32F);
   for (int i = 0; i < 15; ++i) depth.at<float>(i / 5, i % 5) = 0.25f * i;

@@ -70,12 +70,6 @@ std::string FrameName(int frame, const std::string& extension) {
   return name.str();
 }
 
-bool IsPngName(const std::string& name) {
-  std::string lower = name;
-  std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
-  return lower.size() > 4 && lower.compare(lower.size() - 4, 4, ".png") == 0;
-}
-
 std::string JsonList(const std::vector<double>& values) {
   std::ostringstream out;
   out << std::setprecision(17) << "[";
@@ -352,10 +346,10 @@ std::string WriteRigDataset(const std::string& output_dir, const Scene& scene,
         cv::hconcat(halves, raw);
         const std::string name = FrameName(static_cast<int>(f), options.image_extension);
         const fs::path path = tmp / "raw" / name;
-        const std::vector<int> params =
-            IsPngName(name) ? std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 3}
-                            : std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 95};
-        if (!cv::imwrite(path.string(), raw, params)) return "cannot write " + path.string();
+        if (!cv::imwrite(path.string(), raw,
+                         ImageWriteParams(name, options.dataset.effects.jpeg_quality))) {
+          return "cannot write " + path.string();
+        }
       }
       if (extra_log) *extra_log << "wrote " << frames.size() << " raw side-by-side frames\n";
     }
@@ -380,8 +374,13 @@ std::string WriteRigDataset(const std::string& output_dir, const Scene& scene,
         panorama.stitch = spec;
         panoramas.push_back(panorama);
       }
+      // The stitcher's output is drawn from ideal lenses; of the sensor
+      // effects only the noise and the JPEG quality apply to it.
       DatasetOptions stitched_options;
       stitched_options.render = options.dataset.render;
+      stitched_options.effects.noise_sigma = options.dataset.effects.noise_sigma;
+      stitched_options.effects.jpeg_quality = options.dataset.effects.jpeg_quality;
+      stitched_options.effects.seed = options.dataset.effects.seed;
       if (extra_log) *extra_log << "stitching " << panoramas.size() << " panoramas\n";
       error = WriteDataset((tmp / "stitched").string(), scene, panoramas, stitched_options,
                            extra_log);
