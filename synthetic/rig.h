@@ -6,7 +6,8 @@
 //
 // Dataset layout (DIR is written as DIR.tmp, then renamed; see model_io.h):
 //   DIR/images/SENSOR/frameNNN.EXT    one image per lens and frame
-//   DIR/masks/SENSOR/frameNNN.EXT.png the lens's image circle (255 inside),
+//   DIR/masks/SENSOR/frameNNN.EXT.png the lens's image circle (255 inside; with
+//                                     sensor effects the smaller of it and theirs),
 //                                     COLMAP's --ImageReader.mask_path layout
 //   DIR/depth/SENSOR/frameNNN.EXT.depth.bin
 //   DIR/sparse_gt/                    cameras (one per lens), images, points3D,

@@ -15,6 +15,9 @@
 //      lens (the lenses of a rig meter separately);
 //   5. Gaussian read noise in DN, then rounding to 8 bits;
 //   6. JPEG compression at a given quality (applied by the writer).
+// The ground-truth observations (model_io.h, SamplePoints) are those of the
+// ideal lens: those outside the effects' image circle fall on the housing;
+// the written mask tells which pixels see the scene.
 // Randomness (flare placement, housing texture, lens gains, noise) is drawn
 // from `seed` and the lens or image index only: the same inputs give the
 // same bytes, whatever the thread count.
