@@ -13,6 +13,7 @@
 #include "camera_models/double_sphere.h"
 #include "camera_models/equirectangular.h"
 #include "camera_models/eucm.h"
+#include "camera_models/model_test_util.h"
 #include "camera_models/perspective.h"
 #include "camera_models/unified_omni.h"
 
@@ -22,16 +23,12 @@ namespace {
 constexpr double kPi = internal::kPi;
 constexpr double kDeg = kPi / 180;
 
-// Angle between two rays without acos: atan2(|a x b|, a . b).
-double AngleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b));
-}
-
-// Ray at polar angle theta from +z and azimuth phi around it.
-Eigen::Vector3d RayAt(double theta, double phi) {
-  return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-          std::cos(theta)};
-}
+using test::AngleBetween;
+using test::CentralDifferences;
+using test::ExpectJacobianNear;
+using test::ImageFromRayFunctor;
+using test::RayAt;
+using test::RayFromImageFunctor;
 
 // Normalized radius of the projection of a ray at polar angle theta along +x.
 template <typename Model>
@@ -266,57 +263,6 @@ TYPED_TEST(ModelTest, PixelRayPixelRoundTripOverDomain) {
   EXPECT_GT(num_tested, kNumX * kNumY / 5);
   EXPECT_EQ(num_failed, 0) << "last failed pixel " << worst_pixel.transpose();
   EXPECT_LT(max_error, 1e-6) << "worst pixel " << worst_pixel.transpose();
-}
-
-template <typename Model>
-struct ImageFromRayFunctor {
-  template <typename T>
-  bool operator()(const T* ray_in_cam, const T* params, T* pixel) const {
-    return Model::ImageFromRay(params, ray_in_cam, pixel);
-  }
-};
-
-template <typename Model>
-struct RayFromImageFunctor {
-  template <typename T>
-  bool operator()(const T* pixel, const T* params, T* ray_in_cam) const {
-    return Model::RayFromImage(params, pixel, ray_in_cam);
-  }
-};
-
-// Fourth-order central differences of f: R^n -> R^m at x,
-//   f' ~ (f(x - 2h) - 8 f(x - h) + 8 f(x + h) - f(x + 2h)) / 12h,
-// with h = 1e-4 max(1, |x_i|): truncation O(h^4), rounding O(eps / h).
-template <typename Func>
-Eigen::MatrixXd CentralDifferences(const Func& f, std::vector<double> x,
-                                   int num_outputs) {
-  Eigen::MatrixXd jacobian(num_outputs, x.size());
-  for (size_t i = 0; i < x.size(); ++i) {
-    const double x0 = x[i];
-    const double h = 1e-4 * std::max(1.0, std::abs(x0));
-    auto at = [&](double offset) {
-      x[i] = x0 + offset;
-      return Eigen::VectorXd(f(x));
-    };
-    jacobian.col(i) =
-        (at(-2 * h) - 8 * at(-h) + 8 * at(h) - at(2 * h)) / (12 * h);
-    x[i] = x0;
-  }
-  return jacobian;
-}
-
-// Each column must match to 1e-6 relative (floored at 1e-3 of the matrix norm
-// so that exactly-zero columns compare absolutely).
-void ExpectJacobianNear(const Eigen::MatrixXd& autodiff,
-                        const Eigen::MatrixXd& numeric, const char* what) {
-  const double floor = 1e-3 * autodiff.norm();
-  for (int c = 0; c < autodiff.cols(); ++c) {
-    const double scale = std::max(autodiff.col(c).norm(), floor);
-    EXPECT_LE((autodiff.col(c) - numeric.col(c)).norm(), 1e-6 * scale)
-        << what << " column " << c << "\nautodiff\n"
-        << autodiff << "\nnumeric\n"
-        << numeric;
-  }
 }
 
 TYPED_TEST(ModelTest, AutodiffJacobiansMatchCentralDifferences) {

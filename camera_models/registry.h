@@ -10,18 +10,23 @@
 #include "camera_models/double_sphere.h"
 #include "camera_models/equirectangular.h"
 #include "camera_models/eucm.h"
+#include "camera_models/kannala_brandt.h"
+#include "camera_models/ocam.h"
 #include "camera_models/perspective.h"
 #include "camera_models/unified_omni.h"
 
 namespace sphera {
 
 enum class ModelId : int {
-  kPinhole = PinholeModel::kModelId,                  // 1
-  kOpenCV = OpenCVModel::kModelId,                    // 4
-  kEUCM = EUCMModel::kModelId,                        // 16
-  kEquirectangular = EquirectangularModel::kModelId,  // 17
-  kUnifiedOmni = UnifiedOmniModel::kModelId,          // 64
-  kDoubleSphere = DoubleSphereModel::kModelId,        // 65
+  kPinhole = PinholeModel::kModelId,                    // 1
+  kOpenCV = OpenCVModel::kModelId,                      // 4
+  kOpenCVFisheye = OpenCVFisheyeModel::kModelId,        // 5
+  kThinPrismFisheye = ThinPrismFisheyeModel::kModelId,  // 10
+  kEUCM = EUCMModel::kModelId,                          // 16
+  kEquirectangular = EquirectangularModel::kModelId,    // 17
+  kUnifiedOmni = UnifiedOmniModel::kModelId,            // 64
+  kDoubleSphere = DoubleSphereModel::kModelId,          // 65
+  kOCam = OCamModel::kModelId,                          // 66
 };
 
 struct ModelInfo {
@@ -48,6 +53,10 @@ decltype(auto) VisitModel(int model_id, Func&& func) {
       return func(PinholeModel{});
     case OpenCVModel::kModelId:
       return func(OpenCVModel{});
+    case OpenCVFisheyeModel::kModelId:
+      return func(OpenCVFisheyeModel{});
+    case ThinPrismFisheyeModel::kModelId:
+      return func(ThinPrismFisheyeModel{});
     case EUCMModel::kModelId:
       return func(EUCMModel{});
     case EquirectangularModel::kModelId:
@@ -56,6 +65,8 @@ decltype(auto) VisitModel(int model_id, Func&& func) {
       return func(UnifiedOmniModel{});
     case DoubleSphereModel::kModelId:
       return func(DoubleSphereModel{});
+    case OCamModel::kModelId:
+      return func(OCamModel{});
     default:
       throw std::invalid_argument("Unknown camera model id " +
                                   std::to_string(model_id));
@@ -72,7 +83,12 @@ void RequireParamCount(const std::vector<double>& params) {
 
 }  // namespace internal
 
-// The models added by SPHERA (ids 16, 17, 64, 65).
+// The models whose cameras COLMAP hands to SPHERA's own checks and code paths
+// (ids 16, 17, 64, 65). Deliberately not every model this library knows:
+// OPENCV_FISHEYE and THIN_PRISM_FISHEYE are upstream's own models, which
+// COLMAP keeps handling as upstream does until a COLMAP-side adapter routes
+// them here, and OCAM has no such adapter yet. ModelIdFromName and VisitModel
+// know all models.
 inline const std::vector<ModelInfo>& SphereModels() {
   static const std::vector<ModelInfo> models = {
       internal::InfoOf<EUCMModel>(), internal::InfoOf<EquirectangularModel>(),
@@ -88,13 +104,15 @@ inline bool IsSphereModel(int model_id) {
   return false;
 }
 
-// Id of a model known to this library (all six), or -1.
+// Id of a model known to this library (all nine), or -1.
 inline int ModelIdFromName(const std::string& name) {
   for (const ModelInfo& info :
        {internal::InfoOf<PinholeModel>(), internal::InfoOf<OpenCVModel>(),
+        internal::InfoOf<OpenCVFisheyeModel>(),
+        internal::InfoOf<ThinPrismFisheyeModel>(),
         internal::InfoOf<EUCMModel>(), internal::InfoOf<EquirectangularModel>(),
         internal::InfoOf<UnifiedOmniModel>(),
-        internal::InfoOf<DoubleSphereModel>()}) {
+        internal::InfoOf<DoubleSphereModel>(), internal::InfoOf<OCamModel>()}) {
     if (name == info.name) return info.id;
   }
   return -1;

@@ -29,6 +29,9 @@ TEST(Registry, NamesAndIds) {
   EXPECT_EQ(ModelIdFromName("EQUIRECTANGULAR"), 17);
   EXPECT_EQ(ModelIdFromName("UNIFIED_OMNI"), 64);
   EXPECT_EQ(ModelIdFromName("DOUBLE_SPHERE"), 65);
+  EXPECT_EQ(ModelIdFromName("OPENCV_FISHEYE"), 5);
+  EXPECT_EQ(ModelIdFromName("THIN_PRISM_FISHEYE"), 10);
+  EXPECT_EQ(ModelIdFromName("OCAM"), 66);
   EXPECT_EQ(ModelIdFromName("FOO"), -1);
   EXPECT_EQ(ModelIdFromName("eucm"), -1);
   EXPECT_EQ(static_cast<int>(ModelId::kEquirectangular), 17);
@@ -43,7 +46,29 @@ TEST(Registry, NamesAndIds) {
   }
   EXPECT_EQ(sphere_ids, (std::vector<int>{16, 17, 64, 65}));
   for (int id : {16, 17, 64, 65}) EXPECT_TRUE(IsSphereModel(id));
-  for (int id : {0, 1, 4, 5, 66, -1}) EXPECT_FALSE(IsSphereModel(id));
+  // Upstream's fisheye models and OCAM are known but not handed to SPHERA's
+  // COLMAP-side checks.
+  for (int id : {0, 1, 4, 5, 10, 66, -1}) EXPECT_FALSE(IsSphereModel(id));
+}
+
+TEST(Registry, FisheyeAndOCamDispatch) {
+  for (int id : {5, 10, 66}) {
+    const std::vector<double> params = InitialParams(id, 300, 640, 480);
+    EXPECT_EQ(CheckParams(id, params, 640, 480), "") << id;
+    const Eigen::Vector3d ray(0.2, -0.1, 0.9);
+    Eigen::Vector2d pixel;
+    Eigen::Vector3d back;
+    ASSERT_TRUE(ImageFromRay(id, params, ray, &pixel)) << id;
+    ASSERT_TRUE(RayFromImage(id, params, pixel, &back)) << id;
+    EXPECT_LT((back - ray.normalized()).norm(), 1e-12) << id;
+    EXPECT_NEAR(PixelToAngle(id, params), 1.0 / 300, 1e-15) << id;
+    EXPECT_THROW(ImageFromRay(id, {300, 300, 320, 240}, ray, &pixel),
+                 std::invalid_argument);
+  }
+  EXPECT_EQ(InitialParams(5, 300, 640, 480),
+            (std::vector<double>{300, 300, 320, 240, 0, 0, 0, 0}));
+  EXPECT_EQ(InitialParams(66, 300, 640, 480),
+            (std::vector<double>{320, 240, 1, 0, 0, -300, 0, 0, 0}));
 }
 
 TEST(Registry, InitialParamsAreValid) {
@@ -63,7 +88,7 @@ TEST(Registry, UnknownIdThrows) {
   const std::vector<double> params = {1, 2, 3, 4};
   Eigen::Vector2d pixel;
   Eigen::Vector3d ray(0, 0, 1);
-  for (int id : {0, 2, 66, -3}) {
+  for (int id : {0, 2, 67, -3}) {
     try {
       CheckParams(id, params, 0, 0);
       FAIL() << "no throw for " << id;
