@@ -17,8 +17,9 @@ readonly PACKAGES=(
   # OpenImageIO's CMake files need the tools and Imath's Python package
   libopenimageio-dev openimageio-tools python3-imath libcurl4-openssl-dev
   libomp-dev libblas-dev liblapack-dev
-  # SPHERA: image remapping
-  libopencv-dev
+  # SPHERA: image remapping; calibration files (OpenCV FileStorage, Kalibr
+  # YAML, Basalt JSON)
+  libopencv-dev libyaml-cpp-dev nlohmann-json3-dev
   # tests, benchmarks and plots
   python3 python3-numpy python3-scipy python3-matplotlib sqlite3
   # fuzz targets: libFuzzer, AddressSanitizer, UBSan (scripts/fuzz.sh)
