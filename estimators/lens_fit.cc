@@ -183,8 +183,7 @@ class LensFitter {
         if (from_equidistant) {
           ray = EquidistantRay(observation.pixel, center, focal);
         } else if (!Model::RayFromImage(state->params.data(),
-                                        observation.pixel.data(),
-                                        ray.data())) {
+                                        observation.pixel.data(), ray.data())) {
           continue;
         }
         points.push_back(observation.point_in_board);
@@ -221,11 +220,12 @@ class LensFitter {
       for (int b = 0; b < kNumAzimuths; ++b) {
         const double phi = 2 * internal::kPi * (b + 0.5) / kNumAzimuths;
         BoardObservation sample;
-        sample.point_in_board = Eigen::Vector3d(std::sin(theta) * std::cos(phi),
-                                                std::sin(theta) * std::sin(phi),
-                                                std::cos(theta));
-        sample.pixel = center + focal * theta *
-                                    Eigen::Vector2d(std::cos(phi), std::sin(phi));
+        sample.point_in_board =
+            Eigen::Vector3d(std::sin(theta) * std::cos(phi),
+                            std::sin(theta) * std::sin(phi), std::cos(theta));
+        sample.pixel =
+            center +
+            focal * theta * Eigen::Vector2d(std::cos(phi), std::sin(phi));
         samples.push_back(sample);
       }
     }
@@ -235,11 +235,11 @@ class LensFitter {
       int num_residuals = 0;
       for (const BoardObservation& sample : samples) {
         if (!Visible(*params, identity, sample)) continue;
-        problem.AddResidualBlock(
-            BoardReprojectionCost<Model>::Create(sample.point_in_board,
-                                                 sample.pixel),
-            nullptr, params->data(), identity.rotation.data(),
-            identity.translation.data());
+        problem.AddResidualBlock(BoardReprojectionCost<Model>::Create(
+                                     sample.point_in_board, sample.pixel),
+                                 nullptr, params->data(),
+                                 identity.rotation.data(),
+                                 identity.translation.data());
         ++num_residuals;
       }
       if (num_residuals < Model::kNumParams) return false;
@@ -391,14 +391,13 @@ class LensFitter {
       const Eigen::Vector3d rotation_vector(pose.rotation.data());
       const double angle = rotation_vector.norm();
       result.cam_from_board_rotations[image] =
-          angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(
-                          angle, rotation_vector / angle))
+          angle > 0 ? Eigen::Quaterniond(
+                          Eigen::AngleAxisd(angle, rotation_vector / angle))
                     : Eigen::Quaterniond::Identity();
       result.cam_from_board_translations[image] =
           Eigen::Vector3d(pose.translation.data());
     }
-    const std::string check =
-        Model::CheckParams(state.params, width_, height_);
+    const std::string check = Model::CheckParams(state.params, width_, height_);
     if (summary.termination_type != ceres::CONVERGENCE) {
       result.status = LensFitStatus::kNoConvergence;
       result.message = summary.message;
@@ -512,8 +511,8 @@ bool BoardPoseFromRays(const std::vector<Eigen::Vector3d>& points_in_board,
   double front = 0;
   for (int i = 0; i < n; ++i) {
     front += rays_in_cam[i].normalized().dot(
-        H * Eigen::Vector3d(points_in_board[i].x(), points_in_board[i].y(),
-                            1.0));
+        H *
+        Eigen::Vector3d(points_in_board[i].x(), points_in_board[i].y(), 1.0));
   }
   if (front < 0) lambda = -lambda;
   const Eigen::Matrix3d M = lambda * H;
@@ -538,9 +537,9 @@ LensFitResult FitLens(int model_id, int width, int height,
                       const LensFitOptions& options) {
   options.Check();
   if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("FitLens: image size " +
-                                std::to_string(width) + "x" +
-                                std::to_string(height) + " is not positive");
+    throw std::invalid_argument("FitLens: image size " + std::to_string(width) +
+                                "x" + std::to_string(height) +
+                                " is not positive");
   }
   int num_images = 0;
   for (const BoardObservation& observation : observations) {

@@ -1,6 +1,7 @@
 // sphera_lens_fit: fits camera models to checkerboard corners (FitLens).
 //
-//   sphera_lens_fit [--circle_radius PX] CORNERS_FILE MODEL_NAME [MODEL_NAME ...]
+//   sphera_lens_fit [--circle_radius PX] CORNERS_FILE MODEL_NAME
+//                   [MODEL_NAME ...]
 //
 // CORNERS_FILE is text; '#' starts a comment line. The first other line is
 // the image size "width height", then one line per detected corner:
@@ -18,8 +19,8 @@
 // circle_angle_deg (with --circle_radius: the mean angle from the axis of the
 // fitted model's rays at that radius from the principal point, in four
 // directions; how the fit extrapolates to a lens's image circle; nan outside
-// the model's pixel domain), message; a blank line ends a model's block. Exit 1 with one line on stderr
-// for a file or model name it cannot use.
+// the model's pixel domain), message; a blank line ends a model's block.
+// Exit 1 with one line on stderr for a file or model name it cannot use.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -101,22 +102,22 @@ double MaxCornerAngleDeg(const sphera::LensFitResult& result,
         result.cam_from_board_rotations[observation.image_index] *
             observation.point_in_board +
         result.cam_from_board_translations[observation.image_index];
-    max_angle = std::max(max_angle, std::atan2(point_in_cam.head<2>().norm(),
-                                               point_in_cam.z()));
+    max_angle = std::max(
+        max_angle, std::atan2(point_in_cam.head<2>().norm(), point_in_cam.z()));
   }
   return max_angle * 180 / M_PI;
 }
 
-double AngleAtRadiusDeg(const sphera::LensFitResult& result,
-                        double radius_px) {
+double AngleAtRadiusDeg(const sphera::LensFitResult& result, double radius_px) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   Eigen::Vector2d center;
-  const bool has_center = sphera::internal::VisitModel(
-      result.model_id, [&](auto model) {
+  const bool has_center =
+      sphera::internal::VisitModel(result.model_id, [&](auto model) {
         using Model = decltype(model);
         if constexpr (Model::kPrincipalPointIdxs.size() == 2) {
-          center = Eigen::Vector2d(result.params[Model::kPrincipalPointIdxs[0]],
-                                   result.params[Model::kPrincipalPointIdxs[1]]);
+          center =
+              Eigen::Vector2d(result.params[Model::kPrincipalPointIdxs[0]],
+                              result.params[Model::kPrincipalPointIdxs[1]]);
           return true;
         }
         return false;

@@ -61,8 +61,8 @@ BoardScene MakeBoards(const std::vector<double>& center_angles_deg,
 
 std::vector<BoardObservation> Observe(int model_id,
                                       const std::vector<double>& params,
-                                      const BoardScene& scene,
-                                      double noise_px, std::mt19937* rng) {
+                                      const BoardScene& scene, double noise_px,
+                                      std::mt19937* rng) {
   std::normal_distribution<double> noise(0, noise_px);
   std::vector<BoardObservation> observations;
   for (size_t image = 0; image < scene.rotations.size(); ++image) {
@@ -140,8 +140,7 @@ TEST(LensFit, RecoversDoubleSphereFromExactCorners) {
   const int model_id = static_cast<int>(ModelId::kDoubleSphere);
   const std::vector<BoardObservation> observations =
       Observe(model_id, kDoubleSphereParams, scene, 0.0, &rng);
-  const LensFitResult result =
-      FitLens(model_id, kWidth, kHeight, observations);
+  const LensFitResult result = FitLens(model_id, kWidth, kHeight, observations);
   EXPECT_EQ(result.status, LensFitStatus::kSuccess) << result.message;
   EXPECT_EQ(result.num_observations, 6 * 48);
   EXPECT_EQ(result.num_not_visible, 0);
@@ -169,8 +168,7 @@ TEST(LensFit, NoisyCornersGiveTheNoiseLevel) {
   constexpr double kNoisePx = 0.3;
   const std::vector<BoardObservation> observations =
       Observe(model_id, kDoubleSphereParams, scene, kNoisePx, &rng);
-  const LensFitResult result =
-      FitLens(model_id, kWidth, kHeight, observations);
+  const LensFitResult result = FitLens(model_id, kWidth, kHeight, observations);
   EXPECT_EQ(result.status, LensFitStatus::kSuccess) << result.message;
   EXPECT_EQ(result.num_not_visible, 0);
   // sqrt(E|r|²) of 2-D Gaussian noise is sqrt(2) sigma, reduced by the
@@ -178,11 +176,11 @@ TEST(LensFit, NoisyCornersGiveTheNoiseLevel) {
   const double expected_rms =
       std::sqrt(2.0) * kNoisePx * std::sqrt(1.0 - 42.0 / (2 * 288));
   EXPECT_NEAR(result.rms_error_px, expected_rms, 0.1 * expected_rms);
-  EXPECT_NEAR(result.params[0], kDoubleSphereParams[0], 1.0);  // fx
-  EXPECT_NEAR(result.params[1], kDoubleSphereParams[1], 1.0);  // fy
-  EXPECT_NEAR(result.params[2], kDoubleSphereParams[2], 0.5);  // cx
-  EXPECT_NEAR(result.params[3], kDoubleSphereParams[3], 0.5);  // cy
-  EXPECT_NEAR(result.params[4], kDoubleSphereParams[4], 0.01);  // xi
+  EXPECT_NEAR(result.params[0], kDoubleSphereParams[0], 1.0);    // fx
+  EXPECT_NEAR(result.params[1], kDoubleSphereParams[1], 1.0);    // fy
+  EXPECT_NEAR(result.params[2], kDoubleSphereParams[2], 0.5);    // cx
+  EXPECT_NEAR(result.params[3], kDoubleSphereParams[3], 0.5);    // cy
+  EXPECT_NEAR(result.params[4], kDoubleSphereParams[4], 0.01);   // xi
   EXPECT_NEAR(result.params[5], kDoubleSphereParams[5], 0.003);  // alpha
 }
 
@@ -198,8 +196,8 @@ TEST(LensFit, WrongModelFitsWorse) {
       Observe(double_sphere, kDoubleSphereParams, scene, 0.0, &rng);
   const LensFitResult right =
       FitLens(double_sphere, kWidth, kHeight, observations);
-  const LensFitResult eucm = FitLens(static_cast<int>(ModelId::kEUCM), kWidth,
-                                     kHeight, observations);
+  const LensFitResult eucm =
+      FitLens(static_cast<int>(ModelId::kEUCM), kWidth, kHeight, observations);
   EXPECT_EQ(eucm.num_not_visible, 0);
   EXPECT_GT(eucm.rms_error_px, 0.005);
   EXPECT_GT(eucm.rms_error_px, 1000 * right.rms_error_px);
