@@ -234,10 +234,25 @@ function(sphera_fetch_colmap_git out_var error_var)
   if(result EQUAL 0)
     sphera_git("${partial}" result output
                fetch --quiet --depth 1 "${SPHERA_COLMAP_GIT_URL}" "${commit}")
+    if(NOT result EQUAL 0)
+      # A server that does not serve a commit by its id: all branches and
+      # tags, then the commit among them.
+      sphera_git("${partial}" result branches_output
+                 fetch --quiet "${SPHERA_COLMAP_GIT_URL}"
+                 "+refs/heads/*:refs/remotes/origin/*" "+refs/tags/*:refs/tags/*")
+      if(result EQUAL 0)
+        sphera_git("${partial}" result branches_output
+                   cat-file -e "${commit}^{commit}")
+        if(NOT result EQUAL 0)
+          set(branches_output "the commit is on none of its branches and tags")
+        endif()
+      endif()
+      string(APPEND output " / ${branches_output}")
+    endif()
   endif()
   if(result EQUAL 0)
     sphera_git("${partial}" result output
-               -c advice.detachedHead=false checkout --quiet FETCH_HEAD)
+               -c advice.detachedHead=false checkout --quiet "${commit}")
   endif()
   if(NOT result EQUAL 0)
     file(REMOVE_RECURSE "${partial}")
