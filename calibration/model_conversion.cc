@@ -58,7 +58,7 @@ void SolveStage(const std::vector<const RayPixelSample*>& samples,
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
-  options.max_num_iterations = 200;
+  options.max_num_iterations = 100;
   options.function_tolerance = 1e-12;
   options.parameter_tolerance = 1e-12;
   options.gradient_tolerance = 1e-14;
@@ -122,6 +122,7 @@ std::vector<double> FitModel(const std::vector<RayPixelSample>& samples,
   params[Model::kPrincipalPointIdxs[0]] = principal_pixel.x();
   params[Model::kPrincipalPointIdxs[1]] = principal_pixel.y();
 
+  std::vector<const RayPixelSample*> last_stage;
   for (const double limit_deg : {30.0, 60.0, 90.0, 120.0, 150.0, 180.0}) {
     std::vector<const RayPixelSample*> stage;
     for (const RayPixelSample& sample : samples) {
@@ -133,9 +134,11 @@ std::vector<double> FitModel(const std::vector<RayPixelSample>& samples,
         stage.push_back(&sample);
       }
     }
-    if (stage.size() >= static_cast<size_t>(Model::kNumParams)) {
+    if (stage.size() >= static_cast<size_t>(Model::kNumParams) &&
+        stage != last_stage) {
       SolveStage<Model>(stage, &params);
     }
+    last_stage = std::move(stage);
   }
   return params;
 }

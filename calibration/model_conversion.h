@@ -30,8 +30,9 @@
 // in stages (the samples up to 30°, 60°, ... from the axis, each stage started
 // from the last one's result), so that a target whose start sees no ray
 // beyond 90° (a pinhole start, OCAM's) grows into a wide field. A stage uses
-// the samples its start sees; the final errors are over all samples, those
-// the fitted model does not see counted apart.
+// the samples its start sees (a stage with the same samples as the last is
+// skipped); the final errors are over all samples, those the fitted model
+// does not see counted apart.
 //
 // No COLMAP headers: Eigen, Ceres and camera_models/ only.
 #pragma once
@@ -61,13 +62,13 @@ using RayFromImageFunction = std::function<bool(const Eigen::Vector2d& pixel,
                                                 Eigen::Vector3d* ray_in_cam)>;
 
 struct LensSamplingOptions {
-  int num_meridians = 72;
+  int num_meridians = 48;
   // Walk step and the spacing of the kept samples, in degrees (projection)
   // and pixels (unprojection).
   double step_deg = 0.25;
   double sample_spacing_deg = 2.0;
   double step_px = 0.5;
-  double sample_spacing_px = 8.0;
+  double sample_spacing_px = 12.0;
 };
 
 // Samples of the lens by projection: the optical axis must be visible.

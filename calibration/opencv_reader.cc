@@ -51,18 +51,30 @@ std::vector<double> Numbers(const std::string& file, const std::string& field,
       values.push_back(static_cast<double>(item));
     }
   } else if (node.isMap()) {
-    cv::Mat matrix;
-    try {
-      node >> matrix;
-    } catch (const cv::Exception& error) {
-      throw CalibrationError(file, field, "is not a valid matrix (" +
-                                              error.err + ")");
+    // An opencv-matrix, read here: cv::Mat would allocate rows x cols as the
+    // file states them before it reads the data.
+    const cv::FileNode rows = node["rows"];
+    const cv::FileNode cols = node["cols"];
+    const cv::FileNode data = node["data"];
+    if (!rows.isInt() || !cols.isInt() ||
+        !(data.isSeq() || data.isReal() || data.isInt())) {
+      throw CalibrationError(file, field,
+                             "is not a matrix (rows, cols and data)");
     }
-    if (matrix.empty() || matrix.channels() != 1) {
-      throw CalibrationError(file, field, "is not a matrix of numbers");
+    const int num_rows = static_cast<int>(rows);
+    const int num_cols = static_cast<int>(cols);
+    // XML holds a 1x1 matrix's data as one number.
+    const size_t num_values = data.isSeq() ? data.size() : 1;
+    if (num_rows < 1 || num_rows > 16 || num_cols < 1 || num_cols > 16 ||
+        num_values != static_cast<size_t>(num_rows * num_cols)) {
+      throw CalibrationError(file, field,
+                             "is not a valid matrix: " +
+                                 std::to_string(num_values) +
+                                 " data values for " +
+                                 std::to_string(num_rows) + "x" +
+                                 std::to_string(num_cols));
     }
-    matrix.convertTo(matrix, CV_64F);
-    values.assign(matrix.begin<double>(), matrix.end<double>());
+    values = Numbers(file, field, data);
   } else {
     throw CalibrationError(file, field, "is not a number, list or matrix");
   }
@@ -253,8 +265,13 @@ ParsedFile ReadOpenCV(const std::string& text, const std::string& file) {
                              "not a YAML, XML or JSON file of OpenCV");
     }
     return ReadStorage(storage, file);
+  } catch (const CalibrationError&) {
+    throw;
   } catch (const cv::Exception& error) {
     throw CalibrationError(file, "FileStorage", error.err);
+  } catch (const std::exception& error) {
+    // OpenCV's parsers also let std::length_error and the like through.
+    throw CalibrationError(file, "FileStorage", error.what());
   }
 }
 
