@@ -6,17 +6,40 @@
 #                                        cameras) and reconstruct it
 #   scripts/demo.sh IMAGE_DIR [MODEL]    reconstruct your own images; MODEL is a
 #                                        camera model name (default
-#                                        EQUIRECTANGULAR)
+#                                        EQUIRECTANGULAR); the images of a
+#                                        scene rendered by sphera_render
+#                                        (SCENE/images) are evaluated against
+#                                        its ground truth (SCENE/sparse_gt)
 #
+# It prints one line per stage with its counts (images extracted, pairs
+# verified, images registered), a progress line while a stage runs on a
+# terminal, and a summary; the output of every command (setup, build,
+# COLMAP) goes to the log file it names, demo.log in the output folder.
 # Output goes to SPHERA_DEMO_DIR (default build/demo): database.db, sparse/,
-# and for the default scene the rendered images and the ground truth.
+# demo.log, and for the default scene the rendered images and the ground
+# truth.
+#
+# From a clone it installs the packages and builds first (scripts/setup.sh,
+# scripts/build.sh). SPHERA_COLMAP and SPHERA_RENDER name the programs to run
+# instead, without setup and build. Installed (as sphera_demo beside colmap
+# and sphera_render) it runs those, and writes to ./sphera_demo by default.
 set -euo pipefail
 
-readonly REPO_ROOT="$(cd "$(dirname "$0")/.." && pwd)"
-readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build}"
-readonly WORK_DIR="${SPHERA_DEMO_DIR:-${BUILD_DIR}/demo}"
-readonly COLMAP="${BUILD_DIR}/bin/colmap"
-readonly RENDER="${BUILD_DIR}/synthetic/sphera_render"
+readonly SCRIPT_DIR="$(cd "$(dirname "$0")" && pwd)"
+if [ -x "${SCRIPT_DIR}/colmap" ] && [ ! -f "${SCRIPT_DIR}/build.sh" ]; then
+  readonly INSTALLED=1
+  readonly WORK_DIR="${SPHERA_DEMO_DIR:-${PWD}/sphera_demo}"
+  readonly COLMAP="${SPHERA_COLMAP:-${SCRIPT_DIR}/colmap}"
+  readonly RENDER="${SPHERA_RENDER:-${SCRIPT_DIR}/sphera_render}"
+else
+  readonly INSTALLED=0
+  readonly REPO_ROOT="$(cd "${SCRIPT_DIR}/.." && pwd)"
+  readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build}"
+  readonly WORK_DIR="${SPHERA_DEMO_DIR:-${BUILD_DIR}/demo}"
+  readonly COLMAP="${SPHERA_COLMAP:-${BUILD_DIR}/bin/colmap}"
+  readonly RENDER="${SPHERA_RENDER:-${BUILD_DIR}/synthetic/sphera_render}"
+fi
+readonly LOG="${WORK_DIR}/demo.log"
 
 image_dir="${1:-}"
 camera_model="${2:-EQUIRECTANGULAR}"
@@ -24,9 +47,9 @@ if [ -n "${image_dir}" ] && [ ! -d "${image_dir}" ]; then
   echo "demo: image directory '${image_dir}' does not exist" >&2
   exit 1
 fi
-
-"${REPO_ROOT}/scripts/setup.sh"
-"${REPO_ROOT}/scripts/build.sh"
+if [ -n "${image_dir}" ]; then
+  image_dir="$(cd "${image_dir}" && pwd)"
+fi
 
 # Only a folder this script made (it leaves a marker) is ever replaced.
 if [ -d "${WORK_DIR}" ] && [ -n "$(ls -A "${WORK_DIR}")" ] \
@@ -35,39 +58,127 @@ if [ -d "${WORK_DIR}" ] && [ -n "$(ls -A "${WORK_DIR}")" ] \
        "SPHERA_DEMO_DIR to a new folder" >&2
   exit 1
 fi
+case "${image_dir}/" in
+  "${WORK_DIR}"/*)
+    echo "demo: the images must lie outside ${WORK_DIR}, which the demo" \
+         "replaces" >&2
+    exit 1 ;;
+esac
 rm -rf "${WORK_DIR}"
 mkdir -p "${WORK_DIR}"
 touch "${WORK_DIR}/.sphera-demo"
+: > "${LOG}"
+echo "demo: the output of every command goes to ${LOG}"
+
+stage_pid=""
+trap '[ -z "${stage_pid}" ] || kill "${stage_pid}" 2>/dev/null' EXIT
+
+# run_stage LABEL PROGRESS_SED COMMAND...: runs COMMAND with its output
+# appended to the log. On a terminal, one line shows the stage's progress
+# meanwhile: the last log line that the sed expression PROGRESS_SED turns
+# into text. Sets stage_seconds; on failure shows the end of the log and
+# exits with the command's code.
+run_stage() {
+  local label="$1" progress_sed="$2"
+  shift 2
+  local start status=0 progress
+  start=$(date +%s)
+  printf '\n=== %s: %s\n' "${label}" "$*" >> "${LOG}"
+  "$@" >> "${LOG}" 2>&1 &
+  stage_pid=$!
+  if [ -t 1 ]; then
+    while kill -0 "${stage_pid}" 2>/dev/null; do
+      progress="$(tail -n 200 "${LOG}" | sed -n "${progress_sed}" | tail -n 1)"
+      printf '\r\033[K  %s %s (%d s)' "${label}" "${progress}" \
+        "$(( $(date +%s) - start ))"
+      sleep 1
+    done
+    printf '\r\033[K'
+  fi
+  wait "${stage_pid}" || status=$?
+  stage_pid=""
+  stage_seconds=$(( $(date +%s) - start ))
+  if [ "${status}" -ne 0 ]; then
+    echo "demo: ${label} failed (exit ${status}); the end of ${LOG}:" >&2
+    tail -n 15 "${LOG}" >&2
+    exit "${status}"
+  fi
+}
+
+sql() {
+  sqlite3 "${database}" "$1"
+}
+
+if [ "${INSTALLED}" -eq 0 ] && [ -z "${SPHERA_COLMAP:-}" ]; then
+  "${REPO_ROOT}/scripts/setup.sh"
+  run_stage "build" 's/^\(\[[0-9]*\/[0-9]*\]\).*/\1/p' \
+    env SPHERA_BUILD_DIR="${BUILD_DIR}" "${REPO_ROOT}/scripts/build.sh"
+  echo "build:              ${BUILD_DIR} ready (${stage_seconds} s)"
+fi
+for program in "${COLMAP}" "${RENDER}"; do
+  if [ ! -x "${program}" ]; then
+    echo "demo: ${program} is not an executable program" >&2
+    exit 1
+  fi
+done
+
 if [ -z "${image_dir}" ]; then
-  echo "demo: rendering the default scene into ${WORK_DIR}/scene"
-  "${RENDER}" --output "${WORK_DIR}/scene" --layout room9 \
+  run_stage "rendering" 's/^\[\([0-9]*\/[0-9]*\)\].*/\1 images/p' \
+    "${RENDER}" --output "${WORK_DIR}/scene" --layout room9 \
     --model EQUIRECTANGULAR --width 2048 --height 1024 --seed 1 --supersample 2
   image_dir="${WORK_DIR}/scene/images"
+  echo "rendering:          the default scene, $(find "${image_dir}" -type f \
+    | wc -l) panoramas 2048x1024 (${stage_seconds} s)"
 fi
 
 database="${WORK_DIR}/database.db"
 start=$(date +%s)
-"${COLMAP}" feature_extractor --database_path "${database}" \
+run_stage "feature extraction" \
+  's/.*Processed file \[\([0-9]*\/[0-9]*\)\].*/\1 images/p' \
+  "${COLMAP}" feature_extractor --database_path "${database}" \
   --image_path "${image_dir}" --ImageReader.camera_model "${camera_model}" \
   --ImageReader.single_camera_per_folder 1 --FeatureExtraction.use_gpu 0
-"${COLMAP}" exhaustive_matcher --database_path "${database}" \
+echo "feature extraction: $(sql 'SELECT COUNT(*) FROM images') images," \
+  "$(sql 'SELECT SUM(rows) FROM keypoints') keypoints (${stage_seconds} s)"
+
+run_stage "matching" 's/.*Processing block \[\(.*\)\].*/block \1/p' \
+  "${COLMAP}" exhaustive_matcher --database_path "${database}" \
   --FeatureMatching.use_gpu 0
+echo "matching:           $(sql 'SELECT COUNT(*) FROM two_view_geometries
+  WHERE rows > 0') of $(sql 'SELECT COUNT(*) FROM matches') image pairs" \
+  "verified (${stage_seconds} s)"
+
 mkdir -p "${WORK_DIR}/sparse"
-"${COLMAP}" mapper --database_path "${database}" --image_path "${image_dir}" \
+run_stage "mapping" \
+  's/.*Registering image #[0-9]* (num_reg_frames=\([0-9]*\)).*/\1 images registered/p' \
+  "${COLMAP}" mapper --database_path "${database}" --image_path "${image_dir}" \
   --output_path "${WORK_DIR}/sparse"
+models=0
+registered=""
+for model in "${WORK_DIR}"/sparse/*/; do
+  [ -d "${model}" ] || continue
+  models=$(( models + 1 ))
+  count="$("${COLMAP}" model_analyzer --path "${model}" 2>&1 \
+    | sed -n 's/.*Registered images: \([0-9]*\).*/\1/p')"
+  registered="${registered:+${registered} + }${count}"
+done
+echo "mapping:            ${registered:-0} of $(sql 'SELECT COUNT(*) FROM images')" \
+  "images registered in ${models} model(s) (${stage_seconds} s)"
 elapsed=$(( $(date +%s) - start ))
 
 echo
 echo "=== SPHERA demo summary (${elapsed} s) ==="
-echo "images:          $(sqlite3 "${database}" 'SELECT COUNT(*) FROM images')"
-echo "keypoints:       $(sqlite3 "${database}" 'SELECT SUM(rows) FROM keypoints')"
-echo "verified pairs:  $(sqlite3 "${database}" 'SELECT COUNT(*) FROM two_view_geometries WHERE rows > 0')"
-if [ -d "${WORK_DIR}/scene/sparse_gt" ] && [ -d "${WORK_DIR}/sparse/0" ]; then
+echo "images:          $(sql 'SELECT COUNT(*) FROM images')"
+echo "keypoints:       $(sql 'SELECT SUM(rows) FROM keypoints')"
+echo "verified pairs:  $(sql 'SELECT COUNT(*) FROM two_view_geometries WHERE rows > 0')"
+# A scene rendered by sphera_render holds its ground truth beside images/.
+scene_dir="$(dirname "${image_dir}")"
+if [ -d "${scene_dir}/sparse_gt" ] && [ -d "${WORK_DIR}/sparse/0" ]; then
   echo "--- against the ground truth (colmap model_evaluator) ---"
   mkdir -p "${WORK_DIR}/evaluation"
-  "${COLMAP}" model_evaluator --gt_path "${WORK_DIR}/scene/sparse_gt" \
-    --input_path "${WORK_DIR}/sparse/0" --depth_path "${WORK_DIR}/scene/depth" \
-    --output_path "${WORK_DIR}/evaluation" 2>/dev/null | tail -n 7
+  "${COLMAP}" model_evaluator --gt_path "${scene_dir}/sparse_gt" \
+    --input_path "${WORK_DIR}/sparse/0" --depth_path "${scene_dir}/depth" \
+    --output_path "${WORK_DIR}/evaluation" 2>>"${LOG}" | tail -n 7
 fi
 for model in "${WORK_DIR}"/sparse/*/; do
   [ -d "${model}" ] || continue
@@ -75,3 +186,4 @@ for model in "${WORK_DIR}"/sparse/*/; do
     | grep -E "Cameras|Registered images|Points|Mean reprojection error" \
     | sed "s|^.*\] ||; s|^|$(basename "${model}"): |"
 done
+echo "log: ${LOG}"
