@@ -1,22 +1,30 @@
 """`colmap dual_fisheye_splitter`: raw dual-fisheye frames ([lens0 | lens1]
-side by side) become one image per lens, exact pixels inside the image
+side by side, or one file per lens in a front and a back folder or with
+lens suffixes) become one image per lens, exact pixels inside the image
 circle and black outside, plus circle masks, rig_config.json and
 circles.txt, which feature_extractor and rig_configurator take as they are.
-Bad input (a normal photo, an odd width, a circle outside its lens image, an
-unreadable file, an empty folder, existing outputs) fails with a message
-naming it and leaves nothing behind.
+Image circles may reach past the image's edges (the mask is their part
+inside). Bad input (a normal photo, an odd width, an absurd circle, an
+unreadable file, an empty folder, a lens file missing, existing outputs)
+fails with a message naming it and leaves nothing behind.
+
+The real GoPro Fusion frames of the shared data set (beside the repository)
+are split with their maker's circles and with detected ones; those tests
+are skipped, saying so, when the data set is absent.
 
 Images are written and read with PIL (a dependency of matplotlib, which
 scripts/setup.sh installs); the command reads and writes with OpenCV."""
 import json
 import os
+import re
 import shutil
+import time
 import unittest
 
 import numpy as np
 from PIL import Image
 
-from cli_util import Database, TempDirTestCase, listing
+from cli_util import SHARED_DATA, Database, TempDirTestCase, listing
 from sphera_common import CPU_EXTRACTION, run_colmap
 
 # Lens images W x H (not square, to catch a swapped axis) and image circles
@@ -84,6 +92,10 @@ class DualFisheyeSplitterTest(TempDirTestCase):
         for needle in needles:
             self.assertIn(needle, result.stdout)
         self.assertFalse(os.path.exists(output), result.stdout)
+        # The output folder it would have made is not a missing path.
+        for line in result.stdout.splitlines():
+            if "paths that do not exist" in line:
+                self.assertNotIn("--output_path", line)
         leftovers = [p for p in listing(self.tmp) if ".tmp-" in p]
         self.assertEqual(leftovers, [])
         return result.stdout
@@ -258,15 +270,15 @@ class DualFisheyeSplitterTest(TempDirTestCase):
                             input_path=self.path("raw", "sub"))
         shutil.rmtree(self.path("raw", "sub"))
 
-        # A circle outside its lens image, given or detected.
-        too_big = [CIRCLES[0], (49.0, 44.25, 46.0)]
-        self.assert_refused(["lens1", "(cx, cy, r) = (49, 44.25, 46)",
-                             "goes outside the 96x88 lens image"],
-                            "--circles", circles_arg(too_big))
-        off_side = [(20.0, 44.0, 30.0), CIRCLES[1]]
-        save(self.path("cut", "cut.png"), make_raw(32, circles=off_side))
-        self.assert_refused(["lens0", "goes outside the 96x88 lens image"],
-                            input_path=self.path("cut"))
+        # Absurd circles: a centre outside the lens image, a circle that
+        # covers a few percent of it.
+        off_image = [CIRCLES[0], (120.0, 44.0, 30.0)]
+        self.assert_refused(["lens1", "(cx, cy, r) = (120, 44, 30)",
+                             "its centre is outside the 96x88 lens image"],
+                            "--circles", circles_arg(off_image))
+        tiny = [(48.0, 44.0, 10.0), CIRCLES[1]]
+        self.assert_refused(["lens0", "covers 3.7% of the 96x88 lens image"],
+                            "--circles", circles_arg(tiny))
         self.assert_refused(["--circles", "expected two circles"],
                             "--circles", "1,2,3")
 
@@ -308,6 +320,269 @@ class DualFisheyeSplitterTest(TempDirTestCase):
         # Only good.png is left: it splits.
         self.split(*given)
         self.assert_split(self.path("out"), "good.png", good, CIRCLES)
+
+
+    def test_cropped_circles(self):
+        """Circles reaching past the image's edges (real cameras crop them;
+        refused before): given or detected, the mask is their part inside
+        the lens image."""
+        cropped = [(47.0, 44.0, 50.0), (50.5, 43.0, 52.0)]
+        raws = {f"c{i}.png": make_raw(40 + i, circles=cropped)
+                for i in range(3)}
+        for name, raw in raws.items():
+            save(self.path("raw", name), raw)
+        for how, options in (("given", ["--circles", circles_arg(cropped)]),
+                             ("detected", [])):
+            with self.subTest(how):
+                output = self.path("out_" + how)
+                self.split(*options, output=output)
+                circles = self.read_circles(output)
+                got = [circles["lens0"], circles["lens1"]]
+                for lens in range(2):
+                    for value, true in zip(got[lens], cropped[lens]):
+                        self.assertLess(abs(value - true), 1.0,
+                                        (how, lens, got[lens]))
+                    inside = inside_mask(LENS_W, LENS_H, got[lens])
+                    # Cropped: fewer pixels than the whole disc.
+                    self.assertLess(inside.sum(),
+                                    np.pi * got[lens][2] ** 2 - 200)
+                for name, raw in raws.items():
+                    self.assert_split(output, name, raw, got)
+
+    def write_lens_files(self, folder, names, raws, lens):
+        for name, raw in zip(names, raws):
+            save(self.path(folder, name),
+                 np.ascontiguousarray(raw[:, lens * LENS_W:(lens + 1) * LENS_W]))
+
+    def test_front_and_back_folders(self):
+        """One file per lens (GoPro Fusion: FR/GPFR0001.png and
+        BK/GPBK0001.png): the lens tag is found from the names; the frame
+        is named without it."""
+        raws = [make_raw(50 + i) for i in range(3)]
+        self.write_lens_files("FR", [f"GPFR000{i}.png" for i in range(3)],
+                              raws, 0)
+        self.write_lens_files("BK", [f"GPBK000{i}.png" for i in range(3)],
+                              raws, 1)
+        output = self.path("out")
+        result = run_colmap("dual_fisheye_splitter",
+                            "--front_path", self.path("FR"),
+                            "--back_path", self.path("BK"),
+                            "--output_path", output,
+                            "--circles", circles_arg(CIRCLES))
+        self.assertIn('"FR" (front) and "BK" (back)', result.stdout)
+        self.assertIn("3 raw frames -> 6 lens images", result.stdout)
+        for i, raw in enumerate(raws):
+            self.assert_split(output, f"GP000{i}.png", raw, CIRCLES)
+        self.assertEqual(sorted(os.listdir(os.path.join(output, "images",
+                                                        "lens1"))),
+                         ["GP0000.png", "GP0001.png", "GP0002.png"])
+
+        # Detected circles from the separate files, the same names in both
+        # folders (no tag).
+        self.write_lens_files("front", ["a.png", "b.png"], raws[:2], 0)
+        self.write_lens_files("back", ["a.png", "b.png"], raws[:2], 1)
+        output = self.path("out_same")
+        run_colmap("dual_fisheye_splitter", "--front_path", self.path("front"),
+                   "--back_path", self.path("back"), "--output_path", output)
+        circles = self.read_circles(output)
+        detected = [circles["lens0"], circles["lens1"]]
+        for got, true in zip(detected, CIRCLES):
+            for value, expected in zip(got, true):
+                self.assertLess(abs(value - expected), 1.0, (got, true))
+        for name, raw in zip(("a.png", "b.png"), raws):
+            self.assert_split(output, name, raw, detected)
+
+        # A frame without its back file is named; nothing is written. With
+        # --allow_incomplete_frames 1 its front lens is written alone.
+        self.write_lens_files("FR", ["GPFR0003.png"], [make_raw(54)], 0)
+        refused = self.path("refused")
+        result = run_colmap("dual_fisheye_splitter",
+                            "--front_path", self.path("FR"),
+                            "--back_path", self.path("BK"),
+                            "--output_path", refused,
+                            "--circles", circles_arg(CIRCLES), check=False)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("frame GP0003.png", result.stdout)
+        self.assertIn("no file of the back lens", result.stdout)
+        self.assertIn("--allow_incomplete_frames", result.stdout)
+        self.assertFalse(os.path.exists(refused))
+        output = self.path("out_incomplete")
+        result = run_colmap("dual_fisheye_splitter",
+                            "--front_path", self.path("FR"),
+                            "--back_path", self.path("BK"),
+                            "--output_path", output,
+                            "--circles", circles_arg(CIRCLES),
+                            "--allow_incomplete_frames", "1")
+        self.assertIn("4 raw frames -> 7 lens images", result.stdout)
+        self.assertTrue(os.path.exists(os.path.join(
+            output, "images", "lens0", "GP0003.png")))
+        self.assertFalse(os.path.exists(os.path.join(
+            output, "images", "lens1", "GP0003.png")))
+
+        # A normal photo's halves as lens files are refused, named.
+        rng = np.random.default_rng(55)
+        photo = rng.integers(20, 256, size=raws[0].shape, dtype=np.uint8)
+        self.write_lens_files("pFR", ["x.png"], [photo], 0)
+        self.write_lens_files("pBK", ["x.png"], [photo], 1)
+        result = run_colmap("dual_fisheye_splitter",
+                            "--front_path", self.path("pFR"),
+                            "--back_path", self.path("pBK"),
+                            "--output_path", refused,
+                            "--circles", circles_arg(CIRCLES), check=False)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("x.png: lens 0: only", result.stdout)
+        self.assertIn("not a dual-fisheye frame", result.stdout)
+        self.assertFalse(os.path.exists(refused))
+
+    def test_lens_suffixes(self):
+        """One folder, NAME_0.png and NAME_1.png: frame NAME.png."""
+        raws = [make_raw(60 + i) for i in range(2)]
+        for i, raw in enumerate(raws):
+            for lens in range(2):
+                save(self.path("raw", f"IMG_{i}_{lens}.png"),
+                     np.ascontiguousarray(
+                         raw[:, lens * LENS_W:(lens + 1) * LENS_W]))
+        output = self.path("out")
+        self.split("--lens_suffixes", "_0,_1", "--circles",
+                   circles_arg(CIRCLES))
+        for i, raw in enumerate(raws):
+            self.assert_split(output, f"IMG_{i}.png", raw, CIRCLES)
+        save(self.path("raw", "IMG_9_2.png"), raws[0][:, :LENS_W])
+        self.assert_refused(["IMG_9_2.png", "neither \"_0\" nor \"_1\""],
+                            "--lens_suffixes", "_0,_1")
+        self.assert_refused(["--lens_suffixes"], "--lens_suffixes", "_0")
+
+
+REAL = os.path.join(SHARED_DATA, "real_cameras")
+
+
+def read_maker_circles(path):
+    """The (cx, cy, r) of each lens (front, back) of a GoPro parameter file:
+    RADIUS: r and CENTER: cx cy lines, in lens image pixels."""
+    with open(path) as f:
+        text = f.read()
+    radii = [float(v) for v in re.findall(r"RADIUS:\s*([\d.]+)", text)]
+    centres = re.findall(r"CENTER:\s*([\d.]+)\s+([\d.]+)", text)
+    return [(float(cx), float(cy), r) for (cx, cy), r in zip(centres, radii)]
+
+
+@unittest.skipUnless(os.path.isdir(REAL),
+                     f"needs {REAL} (the shared data set beside the "
+                     "repository); not available here")
+class RealGoProFusionTest(TempDirTestCase):
+    """The GoPro Fusion's own files (one per lens, FR/ and BK/; circles
+    cropped by the frame's top and bottom, a lens housing and flare around
+    them): every frame split, with the maker's circles and with detected
+    ones; its maker's stitched panoramas refused."""
+
+    read_circles = DualFisheyeSplitterTest.read_circles
+
+    def link_pairs(self, camera, count):
+        """Folders FR and BK in the temporary folder linking to the first
+        COUNT files of CAMERA's (once); their names."""
+        names = {}
+        for folder in ("FR", "BK"):
+            source = os.path.join(REAL, camera, folder)
+            names[folder] = sorted(os.listdir(source))[:count]
+            if os.path.isdir(self.path(camera, folder)):
+                continue
+            os.makedirs(self.path(camera, folder))
+            for name in names[folder]:
+                os.symlink(os.path.join(source, name),
+                           self.path(camera, folder, name))
+        return names
+
+    def frame_name(self, front_name, back_name):
+        """The name both lenses' files share: the front name without the
+        characters where the two differ (the lens tag)."""
+        prefix = len(os.path.commonprefix([front_name, back_name]))
+        suffix = len(os.path.commonprefix([front_name[::-1],
+                                           back_name[::-1]]))
+        return front_name[:prefix] + front_name[len(front_name) - suffix:]
+
+    def split_and_check(self, camera, count, circles, max_offset):
+        names = self.link_pairs(camera, count)
+        output = self.path(camera + ("_given" if circles else "_detected"))
+        options = ["--circles", circles_arg(circles)] if circles else []
+        start = time.time()
+        result = run_colmap("dual_fisheye_splitter",
+                            "--front_path", self.path(camera, "FR"),
+                            "--back_path", self.path(camera, "BK"),
+                            "--output_path", output, *options)
+        seconds = time.time() - start
+        maker = read_maker_circles(os.path.join(REAL, camera, "circles.txt"))
+        written = self.read_circles(output)
+        used = [written["lens0"], written["lens1"]]
+        if circles:
+            self.assertEqual(used, [tuple(c) for c in circles])
+        for lens in range(2):
+            offset = max(abs(a - b) for a, b in zip(used[lens], maker[lens]))
+            print(f"{camera} {'given' if circles else 'detected'} lens{lens}: "
+                  f"{used[lens]} vs the maker's {maker[lens]}: "
+                  f"{offset:.1f} px; {seconds:.1f} s")
+            self.assertLessEqual(offset, max_offset, (lens, used, maker))
+        self.assertIn(f"{count} raw frames -> {2 * count} lens images",
+                      result.stdout)
+        for front, back in zip(names["FR"], names["BK"]):
+            name = self.frame_name(front, back)
+            for lens, lens_name, source in ((0, "lens0", front),
+                                            (1, "lens1", back)):
+                with Image.open(os.path.join(REAL, camera,
+                                             ("FR", "BK")[lens],
+                                             source)) as original:
+                    width, height = original.size
+                image = load(os.path.join(output, "images", lens_name, name))
+                self.assertEqual(image.shape[:2], (height, width), name)
+                mask = load(os.path.join(output, "masks", lens_name,
+                                         name + ".png"))
+                inside = inside_mask(width, height, used[lens])
+                # The circle reaches past the top and bottom: the mask is
+                # its part inside the image, pixel for pixel.
+                self.assertGreater(used[lens][2] * 2, height)
+                np.testing.assert_array_equal(mask, np.where(inside, 255, 0),
+                                              err_msg=f"{lens_name}/{name}")
+                # Outside the circle black (JPEG leaves a little ringing at
+                # the rim).
+                self.assertLess(float(image[~inside].mean()), 2.0, name)
+                self.assertGreater(float(image[inside].mean()), 20.0, name)
+        return used, maker
+
+    def test_3k_video_frames(self):
+        maker = read_maker_circles(os.path.join(REAL, "gopro_fusion_3k",
+                                                "circles.txt"))
+        self.split_and_check("gopro_fusion_3k", 5, maker, 0)
+        # Detected: the picture's edge is soft (vignetting, blooming next to
+        # a bright sky), and the front lens's circle moves by ~13 px between
+        # the first two and the last three frames: within 1.5% of r of the
+        # maker's circle.
+        self.split_and_check("gopro_fusion_3k", 5, None, 0.015 * 765)
+
+    def test_18mp_photo(self):
+        maker = read_maker_circles(os.path.join(REAL, "gopro_fusion_photo",
+                                                "circles.txt"))
+        self.split_and_check("gopro_fusion_photo", 1, maker, 0)
+        # The maker's front circle lies ~20 px inside the picture's edge at
+        # the bottom and the sides: within 1.5% of r.
+        self.split_and_check("gopro_fusion_photo", 1, None, 0.015 * 1520)
+
+    def test_stitched_panorama_is_refused(self):
+        source = os.path.join(REAL, "gopro_fusion_3k", "STITCHED")
+        name = sorted(os.listdir(source))[0]
+        os.makedirs(self.path("stitched"))
+        os.symlink(os.path.join(source, name), self.path("stitched", name))
+        maker = read_maker_circles(os.path.join(REAL, "gopro_fusion_3k",
+                                                "circles.txt"))
+        for options, needle in ((["--circles", circles_arg(maker)],
+                                 "not a dual-fisheye frame"),
+                                ([], "no image circle")):
+            output = self.path("refused")
+            result = run_colmap("dual_fisheye_splitter", "--input_path",
+                                self.path("stitched"), "--output_path",
+                                output, *options, check=False)
+            self.assertNotEqual(result.returncode, 0)
+            self.assertIn(name, result.stdout)
+            self.assertIn(needle, result.stdout)
+            self.assertFalse(os.path.exists(output))
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
-// Splitting the raw frames of a dual-fisheye camera (Insta360, Ricoh Theta):
-// two image circles side by side in one image become one image per lens
-// plus a mask of its image circle. OpenCV and the standard library only.
+// Splitting the frames of a dual-fisheye camera (Insta360, Ricoh Theta: two
+// image circles side by side in one image; GoPro Fusion: one file per lens)
+// into one image per lens plus a mask of its image circle, and finding the
+// image circles. OpenCV and the standard library only.
 //
 // Layout: a raw frame of width 2W and height H is [lens0 | lens1], lens0 the
 // left W columns, lens1 the right W columns. An image circle (cx, cy, r) is
@@ -8,6 +9,8 @@
 // upper-left corner of the image is (0, 0), the centre of pixel (x, y) is
 // (x + 0.5, y + 0.5); a pixel is inside iff its centre is (in double):
 //   (x + 0.5 - cx)^2 + (y + 0.5 - cy)^2 <= r^2.
+// A circle may reach past the lens image's edges (real cameras crop their
+// circles): what is inside is the circle's part inside the image.
 //
 // Images are 8-bit or 16-bit with 1 to 4 channels; a pixel's intensity is
 // the largest of its colour channels (an alpha channel, the 4th, does not
@@ -29,43 +32,47 @@ struct ImageCircle {
   double r = 0;
 };
 
-// One lens image of a raw frame: its pixels copied exactly, those outside
-// its image circle set to 0 (all channels), and its mask (CV_8UC1, 255
-// inside the circle, 0 outside).
+// One lens image: its pixels copied exactly, those outside its image circle
+// set to 0 (all channels), and its mask (CV_8UC1, 255 inside the circle, 0
+// outside).
 struct LensImage {
   cv::Mat image;
   cv::Mat mask;
 };
 
-// A frame is refused as not dual-fisheye when more than this fraction of its
-// pixels outside both image circles are brighter than the black level: a
-// normal photo or an equirectangular panorama of the same 2:1 size, not a
-// camera's black surround with some noise or stray light.
-inline constexpr double kMaxBrightFractionOutsideCircles = 0.05;
+// An image circle must cover at least this fraction of its lens image: less
+// is a circle of another image size or a typing error, not a lens.
+inline constexpr double kMinImageCircleCoverage = 0.2;
 
-// A detected circle may overshoot its lens image by this much (pixels),
-// the detection's uncertainty for a circle that touches the image's edges;
-// it is then shrunk to fit (ClampDetectedImageCircle). More is an error.
-inline constexpr double kMaxDetectedCircleOvershootPx = 1.0;
+// A frame is dual-fisheye when, in each lens, at least this fraction of the
+// visible rim of its image circle is dark on the outside: the lens's edge,
+// then its housing or black, next to the picture inside. Flare and bright
+// housing parts leave some of the rim bright; a normal photo or a stitched
+// panorama, whose pictures go on across any circle, leave most of it.
+inline constexpr double kMinDarkRimFraction = 0.5;
 
-// Why RAW cannot be a dual-fisheye frame by its size and type (empty, odd
-// width, not 8/16-bit, more than 4 channels), or "".
+// Why RAW cannot be a side-by-side dual-fisheye frame by its size and type
+// (LensImageError, or an odd width), or "".
 std::string DualFisheyeLayoutError(const cv::Mat& raw);
+
+// Why IMAGE cannot be a lens image (empty, not 8/16-bit, more than 4
+// channels), or "".
+std::string LensImageError(const cv::Mat& image);
 
 // The size of each lens image of a raw frame of size RAW_SIZE (W x H).
 cv::Size LensImageSize(const cv::Size& raw_size);
 
-// Why CIRCLE is not a valid image circle of a lens image of LENS_SIZE: not
-// finite, radius <= 0, or the disc [cx - r, cx + r] x [cy - r, cy + r] not
-// inside [0, W] x [0, H] (names the side and by how much); or "".
+// The two lens images of RAW (views of its halves, not copies). RAW must
+// pass DualFisheyeLayoutError.
+std::array<cv::Mat, 2> LensImagesOfRawFrame(const cv::Mat& raw);
+
+// Why CIRCLE cannot be the image circle of a lens image of LENS_SIZE: not
+// finite, radius <= 0, its centre outside the image, its radius more than
+// twice the image's diagonal, or its part inside the image less than
+// kMinImageCircleCoverage of the image; or "". Reaching past the image's
+// edges is normal.
 std::string ImageCircleError(const ImageCircle& circle,
                              const cv::Size& lens_size);
-
-// CIRCLE's radius shrunk so that the disc fits LENS_SIZE, when it overshoots
-// by at most kMaxDetectedCircleOvershootPx; otherwise CIRCLE unchanged (and
-// ImageCircleError says why it is refused).
-ImageCircle ClampDetectedImageCircle(const ImageCircle& circle,
-                                     const cv::Size& lens_size);
 
 // The mask of CIRCLE in an image of SIZE: CV_8UC1, 255 inside, 0 outside.
 // The one definition of "inside" that everything here uses.
@@ -74,37 +81,64 @@ cv::Mat ImageCircleMask(const cv::Size& size, const ImageCircle& circle);
 // CV_8UC1 mask of the pixels of IMAGE brighter than BLACK_LEVEL (255).
 cv::Mat BrightPixelMask(const cv::Mat& image, int black_level);
 
-// The fraction of RAW's pixels outside both image circles (CIRCLES[i] in
-// lens i) that are brighter than BLACK_LEVEL; 0 when no pixel is outside.
-// RAW must pass DualFisheyeLayoutError.
-double BrightFractionOutsideCircles(const cv::Mat& raw,
-                                    const std::array<ImageCircle, 2>& circles,
-                                    int black_level);
+// The fraction of the visible rim of CIRCLE in LENS_IMAGE that is dark on
+// the outside. Along rays from the circle's centre at 360 directions, the
+// mean intensity in a band just inside the circle is compared with that in
+// bands just outside it (each max(2 px, 2% of r) wide, max(1 px, 0.5% of r)
+// away from the circle, so that the lens's blurred edge counts for
+// neither): the rim is dark there when the darkest of three outside bands
+// side by side is at most 60% of the inside. Three, so that a circle given a
+// little inside the picture's edge (a conservative circle from a maker's
+// file, 1-3% of r) still finds the dark beyond it. Only directions whose
+// first outside band is in the image and whose inside band is brighter than
+// BLACK_LEVEL count; *NUM_DIRECTIONS (if not null) is set to their number,
+// and the fraction is 0 when there is none.
+double DarkRimFraction(const cv::Mat& lens_image,
+                       const ImageCircle& circle,
+                       int black_level,
+                       int* num_directions = nullptr);
 
-// Why RAW is not a dual-fisheye frame with CIRCLES: its layout, or more than
-// kMaxBrightFractionOutsideCircles of the pixels outside the circles are
-// brighter than BLACK_LEVEL (gives the percentage); or "". The circles must
-// pass ImageCircleError for RAW's lens size.
-std::string DualFisheyeFrameError(const cv::Mat& raw,
+// Why LENS_IMAGE with CIRCLE is not a lens image of a dual-fisheye camera:
+// less than kMinDarkRimFraction of its circle's rim is dark outside (gives
+// the percentage: a normal photo or a half of an equirectangular
+// panorama), or no part of the rim is in the image with the picture inside
+// it brighter than BLACK_LEVEL; or "". CIRCLE must pass ImageCircleError.
+std::string LensImageCircleError(const cv::Mat& lens_image,
+                                 const ImageCircle& circle,
+                                 int black_level);
+
+// Why LENS_IMAGES with CIRCLES are not the two lens images of one
+// dual-fisheye frame: either fails LensImageError, they differ in size or
+// type, or a lens fails LensImageCircleError (named "lens 0" or "lens 1");
+// or "". The circles must pass ImageCircleError.
+std::string DualFisheyeFrameError(const std::array<cv::Mat, 2>& lens_images,
                                   const std::array<ImageCircle, 2>& circles,
                                   int black_level);
 
-// Detects the image circle of a lens image: the circle bounding its pixels
-// brighter than BLACK_LEVEL. Boundary points are where each row and each
-// column enters and leaves the bright pixels (on the pixel edge between the
-// last black and the first bright pixel, so a hard-edged disc gives points
-// within half a pixel of its circle); points on the image's border are left
-// out (the circle may touch it, the bright area may be cut by it). A circle
-// is fitted to them by algebraic least squares (Kasa), then refitted to the
-// points within max(1.5 px, 3 x the median distance) of the last fit until
-// the inliers no longer change: dark scene content near the rim and bright
-// specks in the black surround fall out as outliers. Last, with the centre
-// fixed, the radius is moved (by at most 1 px) to where it misclassifies
-// the fewest pixels within 2 px of the circle (bright inside, black
-// outside): a hard-edged disc's own mask comes back pixel for pixel when
-// the centre is close enough. Returns "" and sets *CIRCLE, or why no
-// circle was found (too few boundary points, most of them not on one
-// circle, or they do not surround a centre). The circle is not checked
+// Detects the image circle of a lens image by its edge, where the picture
+// ends and the lens's dark edge, housing or black surround begins; none of
+// these need be black, and the circle may reach past the image's edges.
+//
+// Along 720 rays from the image's centre, the places where the mean
+// intensity over a window (1% of the image's smaller side, at least 2 px)
+// before a point exceeds that after it by the most (local maxima, located
+// to a fraction of a pixel), and the outside is at most 60% of the inside,
+// are edge candidates (the 4 strongest a ray). A circle is found among them
+// by RANSAC (3 candidates of different rays; the score is the summed edge
+// strength of the candidates within max(1.5 px, 0.3% of r) of the circle,
+// so that the strong edge of the image circle beats the weak outer edge of
+// a housing), fitted to its inliers by least squares (Kasa) with outliers
+// dropped, and then refined twice from rays cast from its own centre (the
+// strongest edge within a band around the circle a ray). Scene edges, a
+// housing ring and flare are outliers. When the surround is black, so that
+// the circle bounding the pixels brighter than BLACK_LEVEL agrees with the
+// edge within max(2 px, 1% of r), that circle is returned instead: a
+// hard-edged disc's own mask comes back pixel for pixel.
+//
+// Returns "" and sets *CIRCLE, or why no circle was found (too few edge
+// points, or those near the best circle cover too little of its visible
+// rim: less than half of the rays that cross it inside the image, or fewer
+// than 5 of 8 directions from its centre). The circle is not checked
 // against the image size (ImageCircleError does that).
 std::string DetectImageCircle(const cv::Mat& lens_image,
                               int black_level,
@@ -115,9 +149,14 @@ std::string DetectImageCircle(const cv::Mat& lens_image,
 // be off (dark scenes, stray light).
 ImageCircle MedianImageCircle(const std::vector<ImageCircle>& circles);
 
+// LENS_IMAGE with CIRCLE its image circle: the pixels outside it black, and
+// its mask. Throws std::invalid_argument when LENS_IMAGE fails
+// LensImageError or CIRCLE fails ImageCircleError.
+LensImage CutImageCircle(const cv::Mat& lens_image, const ImageCircle& circle);
+
 // Splits RAW into its two lens images with CIRCLES[i] the image circle of
-// lens i. Throws std::invalid_argument when RAW fails DualFisheyeLayoutError
-// or a circle fails ImageCircleError.
+// lens i (CutImageCircle). Throws std::invalid_argument when RAW fails
+// DualFisheyeLayoutError or a circle fails ImageCircleError.
 std::array<LensImage, 2> SplitDualFisheye(
     const cv::Mat& raw, const std::array<ImageCircle, 2>& circles);
 

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace colmap {
 namespace {
@@ -160,7 +161,8 @@ TEST(DualFisheyeSplit, DetectsADrawnCircleWithinOnePixel) {
 
 TEST(DualFisheyeSplit, DetectsACircleThatTouchesTheEdges) {
   // The inscribed circle: its boundary points on the image's border are
-  // left out, and a fit that overshoots by a fraction of a pixel is shrunk.
+  // left out; a fit that overshoots by a fraction of a pixel is a valid
+  // circle (circles may reach past the image).
   const int size = 120;
   const ImageCircle circle{60, 60, 60};
   const cv::Mat raw = MakeRawFrame(size, size, CV_8UC1, {circle, circle});
@@ -170,10 +172,7 @@ TEST(DualFisheyeSplit, DetectsACircleThatTouchesTheEdges) {
   EXPECT_NEAR(detected.cx, 60, 1.0);
   EXPECT_NEAR(detected.cy, 60, 1.0);
   EXPECT_NEAR(detected.r, 60, 1.0);
-  const ImageCircle clamped =
-      ClampDetectedImageCircle(detected, cv::Size(size, size));
-  EXPECT_EQ(ImageCircleError(clamped, cv::Size(size, size)), "");
-  EXPECT_NEAR(clamped.r, 60, 1.0);
+  EXPECT_EQ(ImageCircleError(detected, cv::Size(size, size)), "");
 }
 
 TEST(DualFisheyeSplit, FindsNoCircleInBlackOrFullImages) {
@@ -192,15 +191,21 @@ TEST(DualFisheyeSplit, FindsNoCircleInBlackOrFullImages) {
                        "no image circle found"));
 }
 
-TEST(DualFisheyeSplit, RefusesAFrameThatIsNotBlackOutsideTheCircles) {
+TEST(DualFisheyeSplit, RefusesAFrameWhosePictureGoesOnAcrossTheCircles) {
   const int size = 64;
   const std::array<ImageCircle, 2> circles = {ImageCircle{32, 32, 30},
                                               ImageCircle{32, 32, 30}};
   cv::Mat raw = MakeRawFrame(size, size, CV_8UC3, circles);
-  EXPECT_EQ(DualFisheyeFrameError(raw, circles, 10), "");
-  EXPECT_EQ(BrightFractionOutsideCircles(raw, circles, 10), 0.0);
+  EXPECT_EQ(DualFisheyeFrameError(LensImagesOfRawFrame(raw), circles, 10), "");
+  int num_directions = 0;
+  EXPECT_EQ(DarkRimFraction(
+                LensImagesOfRawFrame(raw)[0], circles[0], 10, &num_directions),
+            1.0);
+  EXPECT_GT(num_directions, 100);
 
-  // Noise at or below the black level and a few bright specks pass.
+  // Noise around the black level and a few bright specks pass; so does a
+  // dark grey surround above the black level (a housing): outside a lens's
+  // circle is dark, not black.
   cv::Mat noisy = raw.clone();
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < 2 * size; ++x) {
@@ -212,21 +217,35 @@ TEST(DualFisheyeSplit, RefusesAFrameThatIsNotBlackOutsideTheCircles) {
   }
   noisy.at<cv::Vec3b>(0, 0) = cv::Vec3b(0, 0, 200);
   noisy.at<cv::Vec3b>(63, 127) = cv::Vec3b(11, 0, 0);
-  EXPECT_EQ(DualFisheyeFrameError(noisy, circles, 10), "");
-  EXPECT_GT(BrightFractionOutsideCircles(noisy, circles, 10), 0.0);
-
-  // A normal photo (texture everywhere) is refused, and so is a frame
-  // whose surround is brighter than the black level.
-  cv::Mat photo(size, 2 * size, CV_8UC3);
-  cv::randu(photo, cv::Scalar::all(0), cv::Scalar::all(256));
-  EXPECT_TRUE(Contains(DualFisheyeFrameError(photo, circles, 10),
-                       "not a dual-fisheye frame"));
-  EXPECT_TRUE(Contains(DualFisheyeFrameError(noisy, circles, 5),
-                       "not a dual-fisheye frame"));
+  EXPECT_EQ(DualFisheyeFrameError(LensImagesOfRawFrame(noisy), circles, 10),
+            "");
+  EXPECT_EQ(DualFisheyeFrameError(LensImagesOfRawFrame(noisy), circles, 5), "");
   // In 16-bit images the black level is scaled by 257.
   cv::Mat raw16;
   noisy.convertTo(raw16, CV_16U, 257);
-  EXPECT_EQ(DualFisheyeFrameError(raw16, circles, 10), "");
+  EXPECT_EQ(DualFisheyeFrameError(LensImagesOfRawFrame(raw16), circles, 10),
+            "");
+
+  // A normal photo (texture everywhere) is refused, naming the lens; so is
+  // a frame whose right lens is a photo.
+  cv::Mat photo(size, 2 * size, CV_8UC3);
+  cv::randu(photo, cv::Scalar::all(0), cv::Scalar::all(256));
+  EXPECT_TRUE(
+      Contains(DualFisheyeFrameError(LensImagesOfRawFrame(photo), circles, 10),
+               "lens 0: only"));
+  EXPECT_TRUE(
+      Contains(DualFisheyeFrameError(LensImagesOfRawFrame(photo), circles, 10),
+               "not a dual-fisheye frame"));
+  cv::Mat half_photo = raw.clone();
+  photo(cv::Rect(size, 0, size, size))
+      .copyTo(half_photo(cv::Rect(size, 0, size, size)));
+  EXPECT_TRUE(Contains(
+      DualFisheyeFrameError(LensImagesOfRawFrame(half_photo), circles, 10),
+      "lens 1: only"));
+  // All black inside: nothing to tell a lens from.
+  EXPECT_TRUE(Contains(
+      LensImageCircleError(cv::Mat::zeros(size, size, CV_8UC1), circles[0], 10),
+      "no part of the rim"));
 }
 
 TEST(DualFisheyeSplit, RefusesAnOddWidth) {
@@ -234,44 +253,198 @@ TEST(DualFisheyeSplit, RefusesAnOddWidth) {
   EXPECT_TRUE(Contains(DualFisheyeLayoutError(raw), "odd width 81"));
   const std::array<ImageCircle, 2> circles = {ImageCircle{20, 20, 10},
                                               ImageCircle{20, 20, 10}};
-  EXPECT_TRUE(Contains(DualFisheyeFrameError(raw, circles, 10), "odd width"));
   EXPECT_THROW(SplitDualFisheye(raw, circles), std::invalid_argument);
+  // Lens images of separate files must agree in size and type.
+  const std::array<cv::Mat, 2> unequal = {cv::Mat(40, 40, CV_8UC3),
+                                          cv::Mat(40, 42, CV_8UC3)};
+  EXPECT_TRUE(Contains(DualFisheyeFrameError(unequal, circles, 10),
+                       "the lens images differ: 40x40"));
   EXPECT_TRUE(Contains(DualFisheyeLayoutError(cv::Mat()), "empty"));
   EXPECT_TRUE(Contains(DualFisheyeLayoutError(cv::Mat(4, 8, CV_32FC1)),
                        "8-bit or 16-bit"));
   EXPECT_EQ(DualFisheyeLayoutError(cv::Mat(40, 80, CV_16UC4)), "");
 }
 
-TEST(DualFisheyeSplit, RefusesACircleOutsideItsLensImage) {
+TEST(DualFisheyeSplit, AcceptsCroppedCirclesAndRefusesAbsurdOnes) {
+  // Real cameras crop their image circles at the frame's edges: a circle
+  // reaching past the image is valid (this was refused before), and its
+  // mask is its part inside the image.
   const cv::Size lens_size(100, 80);
   EXPECT_EQ(ImageCircleError(ImageCircle{50, 40, 40}, lens_size), "");
-  EXPECT_TRUE(Contains(ImageCircleError(ImageCircle{50, 40, 40.5}, lens_size),
-                       "goes outside the 100x80 lens image (by 0.5 px on "
-                       "the top)"));
-  EXPECT_TRUE(Contains(ImageCircleError(ImageCircle{70, 40, 35}, lens_size),
-                       "on the right"));
+  EXPECT_EQ(ImageCircleError(ImageCircle{50, 40, 40.5}, lens_size), "");
+  EXPECT_EQ(ImageCircleError(ImageCircle{70, 40, 35}, lens_size), "");
+  EXPECT_EQ(ImageCircleError(ImageCircle{50, 40, 60}, lens_size), "");
+  EXPECT_EQ(ImageCircleError(ImageCircle{0, 80, 60}, lens_size), "");
   EXPECT_TRUE(Contains(ImageCircleError(ImageCircle{50, 40, 0}, lens_size),
                        "radius <= 0"));
   EXPECT_TRUE(Contains(ImageCircleError(ImageCircle{NAN, 40, 10}, lens_size),
                        "not finite"));
+  EXPECT_TRUE(Contains(ImageCircleError(ImageCircle{-0.5, 40, 30}, lens_size),
+                       "its centre is outside the 100x80 lens image"));
+  EXPECT_TRUE(Contains(ImageCircleError(ImageCircle{50, 81, 30}, lens_size),
+                       "its centre is outside"));
+  // The diagonal is 128.06: 2x is 256.1.
+  EXPECT_EQ(ImageCircleError(ImageCircle{50, 40, 256}, lens_size), "");
+  EXPECT_TRUE(Contains(ImageCircleError(ImageCircle{50, 40, 257}, lens_size),
+                       "more than twice the diagonal"));
+  // About 316 of 8000 pixels (pi 10^2 = 314); r = 23: 20.7%.
+  EXPECT_TRUE(Contains(ImageCircleError(ImageCircle{50, 40, 10}, lens_size),
+                       "covers 4.0% of the 100x80 lens image"));
+  EXPECT_EQ(ImageCircleError(ImageCircle{50, 40, 23}, lens_size), "");
 
   const cv::Mat raw(80, 200, CV_8UC1, cv::Scalar::all(0));
   try {
-    SplitDualFisheye(raw, {ImageCircle{50, 40, 30}, ImageCircle{10, 40, 30}});
+    SplitDualFisheye(raw, {ImageCircle{50, 40, 30}, ImageCircle{150, 40, 30}});
     FAIL() << "no exception";
   } catch (const std::invalid_argument& error) {
     EXPECT_TRUE(Contains(error.what(), "lens 1"));
-    EXPECT_TRUE(Contains(error.what(), "(cx, cy, r) = (10, 40, 30)"));
-    EXPECT_TRUE(Contains(error.what(), "by 20 px on the left"));
+    EXPECT_TRUE(Contains(error.what(), "(cx, cy, r) = (150, 40, 30)"));
+    EXPECT_TRUE(Contains(error.what(), "centre is outside"));
   }
 
-  // A detected circle may overshoot by up to 1 px; it is then shrunk.
-  const ImageCircle shrunk =
-      ClampDetectedImageCircle(ImageCircle{50, 40, 40.6}, lens_size);
-  EXPECT_EQ(shrunk.r, 40);
-  const ImageCircle kept =
-      ClampDetectedImageCircle(ImageCircle{50, 40, 41.5}, lens_size);
-  EXPECT_EQ(kept.r, 41.5);
+  // The split of a cropped circle: mask = circle and image, pixel by pixel.
+  cv::Mat textured(80, 200, CV_8UC3);
+  cv::randu(textured, cv::Scalar::all(1), cv::Scalar::all(256));
+  const std::array<ImageCircle, 2> cropped = {ImageCircle{50.5, 38.25, 47.5},
+                                              ImageCircle{12.0, 70.0, 64.0}};
+  const std::array<LensImage, 2> lenses = SplitDualFisheye(textured, cropped);
+  for (int lens = 0; lens < 2; ++lens) {
+    int num_inside = 0;
+    for (int y = 0; y < 80; ++y) {
+      for (int x = 0; x < 100; ++x) {
+        const bool inside = Inside(x, y, cropped[lens]);
+        num_inside += inside;
+        ASSERT_EQ(lenses[lens].mask.at<uchar>(y, x), inside ? 255 : 0)
+            << "lens " << lens << " " << x << "," << y;
+        ASSERT_EQ(lenses[lens].image.at<cv::Vec3b>(y, x),
+                  inside ? textured.at<cv::Vec3b>(y, lens * 100 + x)
+                         : cv::Vec3b(0, 0, 0));
+      }
+    }
+    // Cropped: fewer pixels inside than the whole disc.
+    EXPECT_LT(num_inside, CV_PI * cropped[lens].r * cropped[lens].r - 100);
+    EXPECT_GT(num_inside, 1000);
+  }
+}
+
+// A lens image as a real camera writes it: a smooth picture inside a circle
+// that reaches past the top and bottom of the image, darkening over its
+// last 2% (vignetting), a dark band at the lens's edge, then a textured grey
+// housing ring and black; flare brightens the housing on one side. The old
+// bright/black boundary takes the housing for the circle.
+cv::Mat MakeHousedLensImage(const cv::Size& size,
+                            const ImageCircle& circle,
+                            unsigned seed) {
+  cv::theRNG().state = seed;
+  cv::Mat coarse(size.height / 16 + 2, size.width / 16 + 2, CV_32FC3);
+  cv::randu(coarse, cv::Scalar::all(60), cv::Scalar::all(230));
+  cv::Mat picture;
+  cv::resize(coarse, picture, size, 0, 0, cv::INTER_CUBIC);
+  cv::Mat grain(size, CV_32FC3);
+  cv::randn(grain, cv::Scalar::all(0), cv::Scalar::all(6));
+  cv::Mat housing(size, CV_32FC3);
+  cv::randu(housing, cv::Scalar::all(35), cv::Scalar::all(70));
+  cv::Mat image(size, CV_8UC3);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      const double d =
+          std::hypot(x + 0.5 - circle.cx, y + 0.5 - circle.cy) / circle.r;
+      cv::Vec3f value;
+      if (d <= 1.0) {
+        const double vignetting = std::clamp((1.0 - d) / 0.02, 0.0, 1.0);
+        value = picture.at<cv::Vec3f>(y, x) * (0.3 + 0.7 * vignetting);
+      } else if (d <= 1.025) {
+        value = cv::Vec3f::all(8);  // the lens's dark edge
+      } else if (d <= 1.2) {
+        value = housing.at<cv::Vec3f>(y, x);
+        // Flare: up to +60 on the left side of the housing.
+        value += cv::Vec3f::all(static_cast<float>(
+            std::max(0.0, 60.0 * (1 - (x + 0.5) / (0.4 * size.width)))));
+      } else {
+        value = cv::Vec3f::all(3);
+      }
+      value += grain.at<cv::Vec3f>(y, x);
+      image.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(value[0]),
+                                            cv::saturate_cast<uchar>(value[1]),
+                                            cv::saturate_cast<uchar>(value[2]));
+    }
+  }
+  return image;
+}
+
+TEST(DualFisheyeSplit, DetectsACroppedCircleInsideAHousingRingWithFlare) {
+  const cv::Size size(420, 400);
+  // 2 x 206 > 400: cropped by 6 px at the top and 10 at the bottom.
+  const std::array<ImageCircle, 2> circles = {ImageCircle{211.3, 198.2, 206.4},
+                                              ImageCircle{206.0, 202.5, 204.0}};
+  for (int lens = 0; lens < 2; ++lens) {
+    const cv::Mat image = MakeHousedLensImage(size, circles[lens], 40 + lens);
+    // The housing is far above the black level: a bright area of radius
+    // 1.2 r, which the circle must not be taken for.
+    ImageCircle detected;
+    ASSERT_EQ(DetectImageCircle(image, 10, &detected), "") << "lens " << lens;
+    EXPECT_NEAR(detected.cx, circles[lens].cx, 2.0) << "lens " << lens;
+    EXPECT_NEAR(detected.cy, circles[lens].cy, 2.0) << "lens " << lens;
+    EXPECT_NEAR(detected.r, circles[lens].r, 2.0) << "lens " << lens;
+    EXPECT_EQ(ImageCircleError(detected, size), "");
+    EXPECT_EQ(LensImageCircleError(image, detected, 10), "");
+    EXPECT_EQ(LensImageCircleError(image, circles[lens], 10), "");
+    // 16-bit the same.
+    cv::Mat image16;
+    image.convertTo(image16, CV_16U, 257);
+    ImageCircle detected16;
+    ASSERT_EQ(DetectImageCircle(image16, 10, &detected16), "");
+    EXPECT_NEAR(detected16.r, detected.r, 0.5);
+  }
+}
+
+TEST(DualFisheyeSplit, TellsAHousedFrameFromAPhotoAndAPanorama) {
+  const cv::Size size(420, 400);
+  const std::array<ImageCircle, 2> circles = {ImageCircle{211.3, 198.2, 206.4},
+                                              ImageCircle{206.0, 202.5, 204.0}};
+  const std::array<cv::Mat, 2> housed = {
+      MakeHousedLensImage(size, circles[0], 50),
+      MakeHousedLensImage(size, circles[1], 51)};
+  EXPECT_EQ(DualFisheyeFrameError(housed, circles, 10), "");
+  EXPECT_GT(DarkRimFraction(housed[0], circles[0], 10), 0.9);
+
+  // A normal photo: a smooth picture across the whole frame (its halves).
+  cv::theRNG().state = 52;
+  cv::Mat coarse(size.height / 16 + 2, 2 * size.width / 16 + 2, CV_8UC3);
+  cv::randu(coarse, cv::Scalar::all(20), cv::Scalar::all(240));
+  cv::Mat photo;
+  cv::resize(coarse,
+             photo,
+             cv::Size(2 * size.width, size.height),
+             0,
+             0,
+             cv::INTER_CUBIC);
+  EXPECT_TRUE(
+      Contains(DualFisheyeFrameError(LensImagesOfRawFrame(photo), circles, 10),
+               "not a dual-fisheye frame"));
+  EXPECT_LT(DarkRimFraction(LensImagesOfRawFrame(photo)[0], circles[0], 10),
+            0.3);
+  // No circle is found in it either.
+  ImageCircle detected;
+  EXPECT_TRUE(
+      Contains(DetectImageCircle(LensImagesOfRawFrame(photo)[0], 10, &detected),
+               "no image circle found"));
+
+  // An equirectangular panorama: bright sky above, darker ground below a
+  // horizon, textured; its halves hold no dark-rimmed circle.
+  cv::Mat panorama = photo.clone();
+  for (int y = 0; y < size.height; ++y) {
+    const double light = y < size.height / 2 ? 1.0 : 0.45;
+    for (int x = 0; x < 2 * size.width; ++x) {
+      cv::Vec3b& pixel = panorama.at<cv::Vec3b>(y, x);
+      for (int c = 0; c < 3; ++c) {
+        pixel[c] = cv::saturate_cast<uchar>(pixel[c] * light);
+      }
+    }
+  }
+  EXPECT_TRUE(Contains(
+      DualFisheyeFrameError(LensImagesOfRawFrame(panorama), circles, 10),
+      "not a dual-fisheye frame"));
 }
 
 TEST(DualFisheyeSplit, TakesTheMedianOfDetectedCircles) {

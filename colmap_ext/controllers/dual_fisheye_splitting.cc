@@ -1,0 +1,1017 @@
+#include "colmap_ext/controllers/dual_fisheye_splitting.h"
+
+#include "colmap/sensor/models.h"
+#include "colmap/util/logging.h"
+#include "colmap_ext/image/dual_fisheye_split.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <exception>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <unistd.h>
+
+namespace colmap {
+namespace {
+
+namespace fs = std::filesystem;
+
+// File name extensions (lower case) of the raw frames looked for in
+// --input_path; other files are left alone. Insta360's .insp stills are
+// JPEG files.
+const std::set<std::string>& RawFrameExtensions() {
+  static const std::set<std::string> extensions = {".jpg",
+                                                   ".jpeg",
+                                                   ".png",
+                                                   ".tif",
+                                                   ".tiff",
+                                                   ".bmp",
+                                                   ".pgm",
+                                                   ".ppm",
+                                                   ".pnm",
+                                                   ".webp",
+                                                   ".insp"};
+  return extensions;
+}
+
+std::string LowerCaseExtension(const fs::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(
+      extension.begin(), extension.end(), extension.begin(), [](char c) {
+        return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      });
+  return extension;
+}
+
+// The extension that tells OpenCV's encoder the format of a lens image
+// written under the name of its raw frame (the input's format).
+std::string EncoderExtension(const fs::path& name) {
+  const std::string extension = LowerCaseExtension(name);
+  return extension == ".insp" ? ".jpg" : extension;
+}
+
+std::vector<std::string> SplitText(const std::string& text, char separator) {
+  std::vector<std::string> parts;
+  std::stringstream stream(text);
+  std::string part;
+  while (std::getline(stream, part, separator)) {
+    parts.push_back(part);
+  }
+  if (!text.empty() && text.back() == separator) {
+    parts.push_back("");
+  }
+  return parts;
+}
+
+std::string Trim(const std::string& text) {
+  const size_t begin = text.find_first_not_of(" \t\r\n");
+  if (begin == std::string::npos) {
+    return "";
+  }
+  return text.substr(begin, text.find_last_not_of(" \t\r\n") - begin + 1);
+}
+
+// Lens names become folder names and JSON strings: letters, digits, '_',
+// '-' and '.' only, not "." or "..", two different ones.
+std::array<std::string, 2> ParseLensNames(const std::string& text) {
+  const std::vector<std::string> names = SplitText(text, ',');
+  if (names.size() != 2 || names[0] == names[1]) {
+    throw std::invalid_argument(
+        "--lens_names: expected two different names "
+        "\"a,b\", got \"" +
+        text + "\"");
+  }
+  for (const std::string& name : names) {
+    const bool allowed = std::all_of(name.begin(), name.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
+             c == '-' || c == '.';
+    });
+    if (name.empty() || !allowed || name == "." || name == "..") {
+      throw std::invalid_argument(
+          "--lens_names: \"" + name +
+          "\" is not a folder name of letters, digits, '_', '-', '.'");
+    }
+  }
+  return {names[0], names[1]};
+}
+
+// The camera for rig_config.json: a model COLMAP knows and parameters it
+// accepts for it, written back as given (shortest round-trip text).
+std::string CameraJson(const std::string& model,
+                       const std::string& params_text) {
+  if (model.empty() && params_text.empty()) {
+    return "";
+  }
+  if (model.empty() || params_text.empty()) {
+    throw std::invalid_argument(
+        "--camera_model and --camera_params go together (rig_configurator "
+        "takes a camera only with both)");
+  }
+  if (!ExistsCameraModelWithName(model)) {
+    throw std::invalid_argument("--camera_model: no camera model \"" + model +
+                                "\"");
+  }
+  std::vector<double> params;
+  for (const std::string& value_text : SplitText(params_text, ',')) {
+    const std::string trimmed = Trim(value_text);
+    char* end = nullptr;
+    const double value = std::strtod(trimmed.c_str(), &end);
+    if (trimmed.empty() || *end != '\0' || !std::isfinite(value)) {
+      throw std::invalid_argument("--camera_params: \"" + value_text +
+                                  "\" is not a number");
+    }
+    params.push_back(value);
+  }
+  const CameraModelId model_id = CameraModelNameToId(model);
+  if (!CameraModelVerifyParams(model_id, params)) {
+    throw std::invalid_argument(
+        "--camera_params: " + std::to_string(params.size()) + " values, but " +
+        model + " takes " + std::to_string(CameraModelNumParams(model_id)) +
+        " (" + CameraModelParamsInfo(model_id) + ")");
+  }
+  std::string json = ",\n        \"camera_model_name\": \"" + model +
+                     "\",\n        \"camera_params\": [";
+  for (size_t i = 0; i < params.size(); ++i) {
+    json += (i > 0 ? ", " : "") + ShortestDoubleText(params[i]);
+  }
+  return json + "]";
+}
+
+// rig_config.json for `colmap rig_configurator`: one rig, lens0 the
+// reference sensor, lens1 back to back with it (cam_from_rig a rotation of
+// 180 degrees about y; quaternion w, x, y, z), the same centre.
+std::string RigConfigJson(const std::array<std::string, 2>& lens_names,
+                          const std::string& camera_json) {
+  return "[\n"
+         "  {\n"
+         "    \"cameras\": [\n"
+         "      {\n"
+         "        \"image_prefix\": \"" +
+         lens_names[0] +
+         "/\",\n"
+         "        \"ref_sensor\": true" +
+         camera_json +
+         "\n"
+         "      },\n"
+         "      {\n"
+         "        \"image_prefix\": \"" +
+         lens_names[1] +
+         "/\",\n"
+         "        \"cam_from_rig_rotation\": [0, 0, 1, 0],\n"
+         "        \"cam_from_rig_translation\": [0, 0, 0]" +
+         camera_json +
+         "\n"
+         "      }\n"
+         "    ]\n"
+         "  }\n"
+         "]\n";
+}
+
+// Whether PATH is FOLDER or below it (both made absolute and normal).
+bool IsWithin(const fs::path& path, const fs::path& folder) {
+  const fs::path relative = fs::weakly_canonical(path).lexically_relative(
+      fs::weakly_canonical(folder));
+  return !relative.empty() && *relative.begin() != "..";
+}
+
+// Throws all of ERRORS (one a line, the first 20) after HEADLINE, if any.
+void ThrowIfAny(const std::string& headline,
+                const std::vector<std::string>& errors) {
+  if (errors.empty()) {
+    return;
+  }
+  std::string message =
+      headline + " (" + std::to_string(errors.size()) + "); nothing written:";
+  constexpr size_t kMaxShown = 20;
+  for (size_t i = 0; i < errors.size() && i < kMaxShown; ++i) {
+    message += "\n  " + errors[i];
+  }
+  if (errors.size() > kMaxShown) {
+    message +=
+        "\n  ... and " + std::to_string(errors.size() - kMaxShown) + " more";
+  }
+  throw std::invalid_argument(message);
+}
+
+// Files written under temporary names beside their final ones, renamed when
+// all are written; anything left half-done (files, folders this made) is
+// removed when it is destroyed before Commit().
+class StagedOutput {
+ public:
+  ~StagedOutput() {
+    if (committed_) {
+      return;
+    }
+    std::error_code ignored;
+    for (const auto& [temporary, final_path] : files_) {
+      fs::remove(temporary, ignored);
+    }
+    for (const fs::path& path : renamed_) {
+      fs::remove(path, ignored);
+    }
+    for (auto folder = created_folders_.rbegin();
+         folder != created_folders_.rend();
+         ++folder) {
+      fs::remove(*folder, ignored);  // only if empty
+    }
+  }
+
+  void Write(const fs::path& path, const std::string& bytes) {
+    CreateFolders(path.parent_path());
+    const fs::path temporary =
+        path.string() + ".tmp-" + std::to_string(::getpid());
+    files_.emplace_back(temporary, path);
+    std::ofstream file(temporary, std::ios::binary);
+    file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    file.close();
+    if (!file) {
+      throw std::runtime_error("cannot write " + temporary.string() +
+                               " (disk full? no permission?)");
+    }
+  }
+
+  void Commit() {
+    for (const auto& [temporary, final_path] : files_) {
+      std::error_code error;
+      fs::rename(temporary, final_path, error);
+      if (error) {
+        throw std::runtime_error("cannot rename " + temporary.string() +
+                                 " to " + final_path.string() + ": " +
+                                 error.message());
+      }
+      renamed_.push_back(final_path);
+    }
+    committed_ = true;
+  }
+
+ private:
+  void CreateFolders(const fs::path& folder) {
+    if (folder.empty() || fs::is_directory(folder)) {
+      return;
+    }
+    CreateFolders(folder.parent_path());
+    std::error_code error;
+    fs::create_directory(folder, error);
+    if (error) {
+      throw std::runtime_error("cannot create the folder " + folder.string() +
+                               ": " + error.message());
+    }
+    created_folders_.push_back(folder);
+  }
+
+  std::vector<std::pair<fs::path, fs::path>> files_;  // temporary, final
+  std::vector<fs::path> renamed_;
+  std::vector<fs::path> created_folders_;
+  bool committed_ = false;
+};
+
+std::string EncodeImage(const cv::Mat& image,
+                        const std::string& extension,
+                        const std::vector<int>& params,
+                        const std::string& what) {
+  std::vector<uchar> bytes;
+  bool encoded = false;
+  try {
+    encoded = cv::imencode(extension, image, bytes, params);
+  } catch (const cv::Exception& error) {
+    throw std::runtime_error("cannot encode " + what + ": " + error.what());
+  }
+  if (!encoded) {
+    throw std::runtime_error("cannot encode " + what + " as " + extension);
+  }
+  return std::string(bytes.begin(), bytes.end());
+}
+
+// The files of one frame: a side-by-side raw frame, or one file per lens
+// (either may be missing in an incomplete frame).
+struct FrameFiles {
+  std::string name;  // relative, '/'-separated: the output files' name
+  fs::path raw;
+  std::array<std::optional<fs::path>, 2> lens_files;
+
+  bool SideBySide() const { return !raw.empty(); }
+  bool Complete() const {
+    return SideBySide() || (lens_files[0] && lens_files[1]);
+  }
+};
+
+// Names (relative to FOLDER, '/'-separated, sorted) of the image files
+// below FOLDER (RawFrameExtensions(); none below EXCLUDED).
+std::vector<std::string> ListImageFiles(const fs::path& folder,
+                                        const fs::path& excluded) {
+  std::vector<std::string> names;
+  for (const fs::directory_entry& entry :
+       fs::recursive_directory_iterator(folder)) {
+    if (!entry.is_regular_file() ||
+        RawFrameExtensions().count(LowerCaseExtension(entry.path())) == 0 ||
+        IsWithin(entry.path(), excluded)) {
+      continue;
+    }
+    names.push_back(entry.path().lexically_relative(folder).generic_string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// The names of --image_list_path (checked: inside input_path, existing,
+// each once).
+std::vector<std::string> ReadImageList(const fs::path& list_path,
+                                       const fs::path& input_path) {
+  std::ifstream list(list_path);
+  if (!list) {
+    throw std::invalid_argument("--image_list_path: cannot read " +
+                                list_path.string());
+  }
+  std::vector<std::string> names;
+  std::set<std::string> seen;
+  std::string line;
+  while (std::getline(list, line)) {
+    const std::string name = Trim(line);
+    if (name.empty()) {
+      continue;
+    }
+    const fs::path relative = fs::path(name).lexically_normal();
+    const bool escapes =
+        relative.is_absolute() || relative.empty() ||
+        std::any_of(relative.begin(), relative.end(), [](const fs::path& p) {
+          return p == "..";
+        });
+    const std::string where = "--image_list_path " + list_path.string() + ": ";
+    if (escapes) {
+      throw std::invalid_argument(where + "\"" + name +
+                                  "\" is not a path inside --input_path");
+    }
+    if (!fs::is_regular_file(input_path / relative)) {
+      throw std::invalid_argument(where + name + ": no such file in " +
+                                  input_path.string());
+    }
+    if (!seen.insert(relative.generic_string()).second) {
+      throw std::invalid_argument(where + name + " is listed twice");
+    }
+    names.push_back(relative.generic_string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// The lens tag of two folders' file names: at POSITION, FRONT in the front
+// lens's names where BACK is in the back lens's (both empty: the same
+// names).
+struct LensTag {
+  size_t position = 0;
+  std::string front;
+  std::string back;
+};
+
+// The tag that most pairs of a front and a back name differ by, among pairs
+// near each other in sorted order (a missing file shifts the order by one)
+// that differ in one place by at most kMaxTagLength characters.
+LensTag FindLensTag(const std::vector<std::string>& fronts,
+                    const std::vector<std::string>& backs) {
+  constexpr size_t kMaxTagLength = 8;
+  constexpr int kNeighbours = 8;
+  std::map<std::tuple<size_t, std::string, std::string>, int> votes;
+  for (int i = 0; i < static_cast<int>(fronts.size()); ++i) {
+    const int j_end = std::min(static_cast<int>(backs.size()), i + kNeighbours);
+    for (int j = std::max(0, i - kNeighbours); j < j_end; ++j) {
+      const std::string& front = fronts[i];
+      const std::string& back = backs[j];
+      if (front == back) {
+        ++votes[{0, "", ""}];
+        continue;
+      }
+      const size_t shorter = std::min(front.size(), back.size());
+      size_t prefix = 0;
+      while (prefix < shorter && front[prefix] == back[prefix]) {
+        ++prefix;
+      }
+      size_t suffix = 0;
+      while (suffix < shorter - prefix && front[front.size() - 1 - suffix] ==
+                                              back[back.size() - 1 - suffix]) {
+        ++suffix;
+      }
+      const std::string front_tag =
+          front.substr(prefix, front.size() - prefix - suffix);
+      const std::string back_tag =
+          back.substr(prefix, back.size() - prefix - suffix);
+      if (front_tag.size() <= kMaxTagLength &&
+          back_tag.size() <= kMaxTagLength &&
+          front_tag.find('/') == std::string::npos &&
+          back_tag.find('/') == std::string::npos) {
+        ++votes[{prefix, front_tag, back_tag}];
+      }
+    }
+  }
+  LensTag tag;
+  int most = 0;
+  for (const auto& [key, count] : votes) {
+    if (count > most) {
+      most = count;
+      tag = {std::get<0>(key), std::get<1>(key), std::get<2>(key)};
+    }
+  }
+  return tag;
+}
+
+// NAME without TAG at POSITION, or nothing when it has no TAG there.
+std::optional<std::string> RemoveTag(const std::string& name,
+                                     size_t position,
+                                     const std::string& tag) {
+  if (name.compare(position, tag.size(), tag) != 0 ||
+      position + tag.size() > name.size()) {
+    return std::nullopt;
+  }
+  return name.substr(0, position) + name.substr(position + tag.size());
+}
+
+// Adds lens LENS's file PATH to the frame NAME of FRAMES; a second file of
+// the same lens for one frame is an error.
+void AddLensFile(const std::string& name,
+                 int lens,
+                 const fs::path& path,
+                 std::map<std::string, FrameFiles>* frames,
+                 std::vector<std::string>* errors) {
+  FrameFiles& frame = (*frames)[name];
+  frame.name = name;
+  if (frame.lens_files[lens]) {
+    errors->push_back(
+        "frame " + name + ": two files of lens " + std::to_string(lens) + ", " +
+        frame.lens_files[lens]->string() + " and " + path.string());
+    return;
+  }
+  frame.lens_files[lens] = path;
+}
+
+std::vector<FrameFiles> FramesOfTwoFolders(
+    const DualFisheyeSplittingOptions& options) {
+  const std::vector<std::string> fronts =
+      ListImageFiles(options.front_path, options.output_path);
+  const std::vector<std::string> backs =
+      ListImageFiles(options.back_path, options.output_path);
+  const LensTag tag = FindLensTag(fronts, backs);
+  if (!tag.front.empty() || !tag.back.empty()) {
+    LOG(INFO) << "dual_fisheye_splitter: the lens tag of the file names: \""
+              << tag.front << "\" (front) and \"" << tag.back << "\" (back)";
+  }
+  std::map<std::string, FrameFiles> frames;
+  std::vector<std::string> errors;
+  const std::array<const std::vector<std::string>*, 2> names = {&fronts,
+                                                                &backs};
+  const std::array<const fs::path*, 2> folders = {&options.front_path,
+                                                  &options.back_path};
+  for (int lens = 0; lens < 2; ++lens) {
+    const std::string& lens_tag = lens == 0 ? tag.front : tag.back;
+    for (const std::string& name : *names[lens]) {
+      // A name without the tag is a frame of its own (and one lens).
+      const std::string frame_name =
+          RemoveTag(name, tag.position, lens_tag).value_or(name);
+      AddLensFile(frame_name, lens, *folders[lens] / name, &frames, &errors);
+    }
+  }
+  ThrowIfAny("files of one lens that fall on one frame", errors);
+  std::vector<FrameFiles> list;
+  for (auto& [name, frame] : frames) {
+    list.push_back(std::move(frame));
+  }
+  return list;
+}
+
+std::vector<FrameFiles> FramesOfSuffixes(
+    const DualFisheyeSplittingOptions& options,
+    const std::vector<std::string>& names) {
+  const std::vector<std::string> suffixes =
+      SplitText(options.lens_suffixes, ',');
+  std::map<std::string, FrameFiles> frames;
+  std::vector<std::string> errors;
+  for (const std::string& name : names) {
+    const fs::path path(name);
+    const std::string stem = path.stem().string();
+    int lens = -1;
+    for (int l = 0; l < 2; ++l) {
+      if (stem.size() > suffixes[l].size() &&
+          stem.compare(stem.size() - suffixes[l].size(),
+                       suffixes[l].size(),
+                       suffixes[l]) == 0 &&
+          (lens < 0 || suffixes[l].size() > suffixes[lens].size())) {
+        lens = l;
+      }
+    }
+    if (lens < 0) {
+      errors.push_back(name + ": its name ends in neither \"" + suffixes[0] +
+                       "\" nor \"" + suffixes[1] + "\" (--lens_suffixes)");
+      continue;
+    }
+    const std::string frame_name =
+        (path.parent_path() /
+         (stem.substr(0, stem.size() - suffixes[lens].size()) +
+          path.extension().string()))
+            .generic_string();
+    AddLensFile(frame_name, lens, options.input_path / name, &frames, &errors);
+  }
+  ThrowIfAny("files that are no lens's", errors);
+  std::vector<FrameFiles> list;
+  for (auto& [name, frame] : frames) {
+    list.push_back(std::move(frame));
+  }
+  return list;
+}
+
+// The frames OPTIONS name, sorted by name; incomplete ones are errors
+// unless allowed (then each is named in a warning).
+std::vector<FrameFiles> ListFrames(const DualFisheyeSplittingOptions& options) {
+  std::vector<FrameFiles> frames;
+  if (!options.front_path.empty()) {
+    frames = FramesOfTwoFolders(options);
+  } else {
+    const std::vector<std::string> names =
+        options.image_list_path.empty()
+            ? ListImageFiles(options.input_path, options.output_path)
+            : ReadImageList(options.image_list_path, options.input_path);
+    if (!options.lens_suffixes.empty()) {
+      frames = FramesOfSuffixes(options, names);
+    } else {
+      for (const std::string& name : names) {
+        frames.push_back({name, options.input_path / name, {}});
+      }
+    }
+  }
+  if (frames.empty()) {
+    std::string extensions;
+    for (const std::string& extension : RawFrameExtensions()) {
+      extensions += (extensions.empty() ? "" : " ") + extension;
+    }
+    const std::string where =
+        !options.front_path.empty()
+            ? options.front_path.string() + " and " + options.back_path.string()
+        : options.image_list_path.empty() ? options.input_path.string()
+                                          : options.image_list_path.string();
+    throw std::invalid_argument("no raw frames in " + where + " (looked for " +
+                                extensions + ")");
+  }
+  std::vector<std::string> incomplete;
+  for (const FrameFiles& frame : frames) {
+    if (frame.Complete()) {
+      continue;
+    }
+    const int present = frame.lens_files[0] ? 0 : 1;
+    incomplete.push_back(
+        "frame " + frame.name + ": " + frame.lens_files[present]->string() +
+        ", but no file of " +
+        (present == 0 ? "the back lens (lens 1)" : "the front lens (lens 0)"));
+  }
+  if (!options.allow_incomplete_frames) {
+    ThrowIfAny(
+        "frames with a lens file missing (--allow_incomplete_frames 1 writes "
+        "their one lens)",
+        incomplete);
+  }
+  for (const std::string& message : incomplete) {
+    LOG(WARNING) << "dual_fisheye_splitter: " << message;
+  }
+  return frames;
+}
+
+// PATH decoded as stored (bit depth, channels, no EXIF rotation); throws
+// naming the file when it cannot be.
+cv::Mat ReadImage(const fs::path& path) {
+  cv::Mat image;
+  try {
+    image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& error) {
+    throw std::runtime_error("cannot read the image " + path.string() + ": " +
+                             error.what());
+  }
+  if (image.empty()) {
+    throw std::runtime_error("cannot read the image " + path.string() +
+                             " (not an image, or truncated?)");
+  }
+  return image;
+}
+
+// The lens images of FRAME (empty for a missing lens file); throws naming
+// the frame when a file cannot be read or is no lens image.
+std::array<cv::Mat, 2> ReadLensImages(const FrameFiles& frame) {
+  try {
+    if (frame.SideBySide()) {
+      const cv::Mat raw = ReadImage(frame.raw);
+      if (const std::string error = DualFisheyeLayoutError(raw);
+          !error.empty()) {
+        throw std::invalid_argument(error);
+      }
+      return LensImagesOfRawFrame(raw);
+    }
+    std::array<cv::Mat, 2> lenses;
+    for (int lens = 0; lens < 2; ++lens) {
+      if (frame.lens_files[lens]) {
+        lenses[lens] = ReadImage(*frame.lens_files[lens]);
+        if (const std::string error = LensImageError(lenses[lens]);
+            !error.empty()) {
+          throw std::invalid_argument(frame.lens_files[lens]->string() + ": " +
+                                      error);
+        }
+      }
+    }
+    return lenses;
+  } catch (const std::exception& error) {
+    throw std::invalid_argument(frame.name + ": " + error.what());
+  }
+}
+
+// Why the lens images of FRAME are not a dual-fisheye frame with CIRCLES
+// (of an incomplete frame, its one lens), or "".
+std::string FrameError(const std::array<cv::Mat, 2>& lenses,
+                       const std::array<ImageCircle, 2>& circles,
+                       int black_level) {
+  if (!lenses[0].empty() && !lenses[1].empty()) {
+    return DualFisheyeFrameError(lenses, circles, black_level);
+  }
+  const int lens = lenses[0].empty() ? 1 : 0;
+  const std::string error =
+      LensImageCircleError(lenses[lens], circles[lens], black_level);
+  return error.empty() ? "" : "lens " + std::to_string(lens) + ": " + error;
+}
+
+std::string SizeText(const cv::Size& size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+// Throws naming the output files that exist already (none may be
+// overwritten) and the frames whose format OpenCV cannot write.
+void CheckOutputsAreNew(const std::vector<FrameFiles>& frames,
+                        const std::array<std::string, 2>& lens_names,
+                        const fs::path& out) {
+  std::vector<std::string> unwritable;
+  std::vector<std::string> existing;
+  for (const fs::path& path : {out / "rig_config.json", out / "circles.txt"}) {
+    if (fs::exists(path)) {
+      existing.push_back(path.string());
+    }
+  }
+  for (const FrameFiles& frame : frames) {
+    if (!cv::haveImageWriter("x" + EncoderExtension(frame.name))) {
+      unwritable.push_back(frame.name + ": OpenCV cannot write its format (" +
+                           LowerCaseExtension(frame.name) + ")");
+    }
+    for (const std::string& lens : lens_names) {
+      for (const fs::path& path :
+           {out / "images" / lens / frame.name,
+            out / "masks" / lens / (frame.name + ".png")}) {
+        if (fs::exists(path)) {
+          existing.push_back(path.string());
+        }
+      }
+    }
+  }
+  ThrowIfAny("raw frames in formats OpenCV cannot write", unwritable);
+  ThrowIfAny(
+      "refusing to overwrite existing output files (choose another "
+      "--output_path or remove them)",
+      existing);
+}
+
+// What the first pass over the frames found.
+struct FrameScan {
+  cv::Size lens_size;
+  // Without given circles: the circles detected in each lens, and the first
+  // failure to detect one (frame name, why).
+  std::array<std::vector<ImageCircle>, 2> detected;
+  std::array<std::pair<std::string, std::string>, 2> first_failure;
+};
+
+// Pass 1: every frame readable, of one lens image size; with GIVEN_CIRCLES
+// they are checked against the first frame's size and every frame against
+// them, else the image circles of every frame are detected. Throws naming
+// every bad frame.
+FrameScan ScanFrames(
+    const std::vector<FrameFiles>& frames,
+    const std::array<std::string, 2>& lens_names,
+    const std::optional<std::array<ImageCircle, 2>>& given_circles,
+    int black_level) {
+  FrameScan scan;
+  std::vector<std::string> errors;
+  std::string first_name;
+  for (const FrameFiles& frame : frames) {
+    std::array<cv::Mat, 2> lenses;
+    try {
+      lenses = ReadLensImages(frame);
+    } catch (const std::exception& error) {
+      errors.push_back(error.what());
+      continue;
+    }
+    const cv::Size size = (lenses[0].empty() ? lenses[1] : lenses[0]).size();
+    if (first_name.empty()) {
+      first_name = frame.name;
+      scan.lens_size = size;
+      if (given_circles) {
+        for (int lens = 0; lens < 2; ++lens) {
+          if (const std::string error =
+                  ImageCircleError((*given_circles)[lens], size);
+              !error.empty()) {
+            throw std::invalid_argument(lens_names[lens] +
+                                        " (--circles): " + error);
+          }
+        }
+      }
+    }
+    if (frame.SideBySide() && size != scan.lens_size) {
+      const cv::Size raw_size(2 * size.width, size.height);
+      errors.push_back(
+          frame.name + ": " + SizeText(raw_size) + ", but " + first_name +
+          " is " + SizeText({2 * scan.lens_size.width, scan.lens_size.height}) +
+          " (all frames must come from one camera)");
+      continue;
+    }
+    bool size_error = false;
+    for (int lens = 0; lens < 2; ++lens) {
+      if (!lenses[lens].empty() && lenses[lens].size() != scan.lens_size) {
+        errors.push_back(frame.name + ": " + lens_names[lens] + " is " +
+                         SizeText(lenses[lens].size()) + ", but " + first_name +
+                         "'s lens images are " + SizeText(scan.lens_size) +
+                         " (all frames must come from one camera)");
+        size_error = true;
+        break;
+      }
+    }
+    if (size_error) {
+      continue;
+    }
+    if (given_circles) {
+      if (const std::string error =
+              FrameError(lenses, *given_circles, black_level);
+          !error.empty()) {
+        errors.push_back(frame.name + ": " + error);
+      }
+      continue;
+    }
+    for (int lens = 0; lens < 2; ++lens) {
+      if (lenses[lens].empty()) {
+        continue;
+      }
+      ImageCircle circle;
+      const std::string error =
+          DetectImageCircle(lenses[lens], black_level, &circle);
+      if (error.empty()) {
+        scan.detected[lens].push_back(circle);
+      } else if (scan.first_failure[lens].first.empty()) {
+        scan.first_failure[lens] = {frame.name, error};
+      }
+    }
+  }
+  ThrowIfAny("bad raw frames", errors);
+  return scan;
+}
+
+// The image circle of each lens from the detections of SCAN: their median
+// over the frames where one was found. Throws naming the lens when a
+// circle was found in no frame or cannot be a lens's.
+std::array<ImageCircle, 2> CirclesFromDetections(
+    const FrameScan& scan,
+    size_t num_frames,
+    const std::array<std::string, 2>& lens_names,
+    int black_level) {
+  std::array<ImageCircle, 2> circles;
+  for (int lens = 0; lens < 2; ++lens) {
+    if (scan.detected[lens].empty()) {
+      const auto& [name, why] = scan.first_failure[lens];
+      throw std::invalid_argument(
+          name + ": " + lens_names[lens] + ": " + why +
+          "; no image circle in " + lens_names[lens] + " of any of the " +
+          std::to_string(num_frames) +
+          " frames: not dual-fisheye frames (a normal photo or an "
+          "equirectangular panorama?), or --black_level " +
+          std::to_string(black_level) +
+          " is not below the picture at the rim (or give --circles)");
+    }
+    circles[lens] = MedianImageCircle(scan.detected[lens]);
+    if (const std::string error =
+            ImageCircleError(circles[lens], scan.lens_size);
+        !error.empty()) {
+      throw std::invalid_argument(lens_names[lens] + " (detected): " + error);
+    }
+  }
+  return circles;
+}
+
+// Pass 2 with detected circles: every frame is checked against them.
+void CheckFrames(const std::vector<FrameFiles>& frames,
+                 const std::array<ImageCircle, 2>& circles,
+                 int black_level) {
+  std::vector<std::string> errors;
+  for (const FrameFiles& frame : frames) {
+    try {
+      if (const std::string error =
+              FrameError(ReadLensImages(frame), circles, black_level);
+          !error.empty()) {
+        errors.push_back(frame.name + ": " + error);
+      }
+    } catch (const std::exception& error) {
+      errors.push_back(error.what());
+    }
+  }
+  ThrowIfAny("bad raw frames", errors);
+}
+
+// The header of the renderer's circles.txt (synthetic/rig.h), so that one
+// reader takes both.
+std::string CirclesText(const std::array<std::string, 2>& lens_names,
+                        const std::array<ImageCircle, 2>& circles) {
+  std::string text = "# SENSOR CX CY R (pixels, image corner at 0, 0)\n";
+  for (int lens = 0; lens < 2; ++lens) {
+    text += lens_names[lens] + " " + ShortestDoubleText(circles[lens].cx) +
+            " " + ShortestDoubleText(circles[lens].cy) + " " +
+            ShortestDoubleText(circles[lens].r) + "\n";
+  }
+  return text;
+}
+
+// The last pass: every output file under a temporary name, then renamed.
+void WriteOutputs(const DualFisheyeSplittingOptions& options,
+                  const std::vector<FrameFiles>& frames,
+                  const std::array<std::string, 2>& lens_names,
+                  const std::array<ImageCircle, 2>& circles,
+                  const cv::Size& lens_size,
+                  const std::string& camera_json) {
+  const fs::path& out = options.output_path;
+  StagedOutput staged;
+  std::array<std::string, 2> mask_bytes;  // the same for every frame
+  for (int lens = 0; lens < 2; ++lens) {
+    mask_bytes[lens] = EncodeImage(ImageCircleMask(lens_size, circles[lens]),
+                                   ".png",
+                                   {},
+                                   lens_names[lens] + "'s mask");
+  }
+  for (const FrameFiles& frame : frames) {
+    const std::array<cv::Mat, 2> lenses = ReadLensImages(frame);
+    const std::string extension = EncoderExtension(frame.name);
+    std::vector<int> params;
+    if (extension == ".jpg" || extension == ".jpeg") {
+      params = {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality};
+    }
+    for (int lens = 0; lens < 2; ++lens) {
+      if (lenses[lens].empty()) {
+        continue;
+      }
+      const LensImage cut = CutImageCircle(lenses[lens], circles[lens]);
+      staged.Write(out / "images" / lens_names[lens] / frame.name,
+                   EncodeImage(cut.image,
+                               extension,
+                               params,
+                               lens_names[lens] + " of " + frame.name));
+      staged.Write(out / "masks" / lens_names[lens] / (frame.name + ".png"),
+                   mask_bytes[lens]);
+    }
+  }
+  staged.Write(out / "rig_config.json", RigConfigJson(lens_names, camera_json));
+  staged.Write(out / "circles.txt", CirclesText(lens_names, circles));
+  staged.Commit();
+}
+
+// How far the farthest of CIRCLES is from MEDIAN (centre distance plus
+// radius difference, pixels).
+double LargestDeviation(const std::vector<ImageCircle>& circles,
+                        const ImageCircle& median) {
+  double largest = 0;
+  for (const ImageCircle& circle : circles) {
+    largest =
+        std::max(largest,
+                 std::hypot(circle.cx - median.cx, circle.cy - median.cy) +
+                     std::abs(circle.r - median.r));
+  }
+  return largest;
+}
+
+}  // namespace
+
+void DualFisheyeSplittingOptions::Check() const {
+  if (black_level < 0 || black_level > 254) {
+    throw std::invalid_argument("--black_level " + std::to_string(black_level) +
+                                ": expected 0..254 (8-bit scale)");
+  }
+  if (jpeg_quality < 1 || jpeg_quality > 100) {
+    throw std::invalid_argument(
+        "--jpeg_quality " + std::to_string(jpeg_quality) + ": expected 1..100");
+  }
+  if (front_path.empty() != back_path.empty()) {
+    throw std::invalid_argument(
+        "--front_path and --back_path go together (one folder per lens)");
+  }
+  if (front_path.empty() == input_path.empty()) {
+    throw std::invalid_argument(
+        "give either --input_path (side-by-side frames, or with "
+        "--lens_suffixes one file per lens) or --front_path and --back_path");
+  }
+  if (!front_path.empty() &&
+      (!image_list_path.empty() || !lens_suffixes.empty())) {
+    throw std::invalid_argument(
+        "--image_list_path and --lens_suffixes go with --input_path, not "
+        "with --front_path and --back_path");
+  }
+  if (!lens_suffixes.empty()) {
+    const std::vector<std::string> suffixes = SplitText(lens_suffixes, ',');
+    if (suffixes.size() != 2 || suffixes[0].empty() || suffixes[1].empty() ||
+        suffixes[0] == suffixes[1] ||
+        lens_suffixes.find('/') != std::string::npos) {
+      throw std::invalid_argument(
+          "--lens_suffixes: expected two different file name endings "
+          "\"s0,s1\" (such as \"_0,_1\"), got \"" +
+          lens_suffixes + "\"");
+    }
+  }
+  const std::pair<const char*, const fs::path*> folders[] = {
+      {"--input_path", &input_path},
+      {"--front_path", &front_path},
+      {"--back_path", &back_path}};
+  for (const auto& [option, folder] : folders) {
+    if (!folder->empty() && !fs::is_directory(*folder)) {
+      throw std::invalid_argument(std::string(option) + " " + folder->string() +
+                                  " is not a folder");
+    }
+  }
+  if (fs::exists(output_path) && !fs::is_directory(output_path)) {
+    throw std::invalid_argument("--output_path " + output_path.string() +
+                                " exists and is not a folder");
+  }
+  ParseLensNames(lens_names);
+  CameraJson(camera_model, camera_params);
+  if (!circles.empty()) {
+    std::array<ImageCircle, 2> parsed;
+    if (const std::string error = ParseImageCircles(circles, &parsed);
+        !error.empty()) {
+      throw std::invalid_argument("--circles: " + error);
+    }
+  }
+}
+
+void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
+  options.Check();
+  const std::array<std::string, 2> lens_names =
+      ParseLensNames(options.lens_names);
+  const std::string camera_json =
+      CameraJson(options.camera_model, options.camera_params);
+  std::optional<std::array<ImageCircle, 2>> given_circles;
+  if (!options.circles.empty()) {
+    std::array<ImageCircle, 2> circles;
+    ParseImageCircles(options.circles, &circles);
+    given_circles = circles;
+  }
+
+  const std::vector<FrameFiles> frames = ListFrames(options);
+  CheckOutputsAreNew(frames, lens_names, options.output_path);
+  const FrameScan scan =
+      ScanFrames(frames, lens_names, given_circles, options.black_level);
+  std::array<ImageCircle, 2> circles;
+  if (given_circles) {
+    circles = *given_circles;
+  } else {
+    circles = CirclesFromDetections(
+        scan, frames.size(), lens_names, options.black_level);
+    CheckFrames(frames, circles, options.black_level);
+  }
+  for (int lens = 0; lens < 2; ++lens) {
+    std::ostringstream origin;
+    if (given_circles) {
+      origin << "given";
+    } else {
+      origin << "detected (median of " << scan.detected[lens].size() << " of "
+             << frames.size() << " frames, each within "
+             << std::lround(
+                    LargestDeviation(scan.detected[lens], circles[lens]))
+             << " px of it)";
+    }
+    LOG(INFO) << "dual_fisheye_splitter: " << lens_names[lens]
+              << ": image circle (cx, cy, r) = ("
+              << ShortestDoubleText(circles[lens].cx) << ", "
+              << ShortestDoubleText(circles[lens].cy) << ", "
+              << ShortestDoubleText(circles[lens].r) << ") " << origin.str();
+  }
+
+  WriteOutputs(
+      options, frames, lens_names, circles, scan.lens_size, camera_json);
+  size_t num_images = 0;
+  for (const FrameFiles& frame : frames) {
+    num_images += frame.SideBySide() ? 2
+                                     : (frame.lens_files[0] ? 1 : 0) +
+                                           (frame.lens_files[1] ? 1 : 0);
+  }
+  LOG(INFO) << "dual_fisheye_splitter: " << frames.size() << " raw frames -> "
+            << num_images << " lens images and masks ("
+            << SizeText(scan.lens_size) << ") in "
+            << options.output_path.string() << "/images/{" << lens_names[0]
+            << "," << lens_names[1] << "}";
+}
+
+}  // namespace colmap
