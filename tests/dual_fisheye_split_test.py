@@ -82,6 +82,14 @@ class DualFisheyeSplitterTest(TempDirTestCase):
                           "--output_path", output or self.path("out"),
                           *args, check=check)
 
+    def split_folders(self, front, back, output, *args, check=True):
+        """The splitter on one folder per lens, FRONT and BACK (below the
+        temporary folder)."""
+        return run_colmap("dual_fisheye_splitter",
+                          "--front_path", self.path(front),
+                          "--back_path", self.path(back),
+                          "--output_path", output, *args, check=check)
+
     def assert_refused(self, needles, *args, input_path=None):
         """The command fails naming every one of NEEDLES; --output_path is
         not created and no temporary file is left anywhere."""
@@ -364,11 +372,8 @@ class DualFisheyeSplitterTest(TempDirTestCase):
         self.write_lens_files("BK", [f"GPBK000{i}.png" for i in range(3)],
                               raws, 1)
         output = self.path("out")
-        result = run_colmap("dual_fisheye_splitter",
-                            "--front_path", self.path("FR"),
-                            "--back_path", self.path("BK"),
-                            "--output_path", output,
-                            "--circles", circles_arg(CIRCLES))
+        result = self.split_folders("FR", "BK", output,
+                                    "--circles", circles_arg(CIRCLES))
         self.assertIn('"FR" (front) and "BK" (back)', result.stdout)
         self.assertIn("3 raw frames -> 6 lens images", result.stdout)
         for i, raw in enumerate(raws):
@@ -382,8 +387,7 @@ class DualFisheyeSplitterTest(TempDirTestCase):
         self.write_lens_files("front", ["a.png", "b.png"], raws[:2], 0)
         self.write_lens_files("back", ["a.png", "b.png"], raws[:2], 1)
         output = self.path("out_same")
-        run_colmap("dual_fisheye_splitter", "--front_path", self.path("front"),
-                   "--back_path", self.path("back"), "--output_path", output)
+        self.split_folders("front", "back", output)
         circles = self.read_circles(output)
         detected = [circles["lens0"], circles["lens1"]]
         for got, true in zip(detected, CIRCLES):
@@ -396,23 +400,18 @@ class DualFisheyeSplitterTest(TempDirTestCase):
         # --allow_incomplete_frames 1 its front lens is written alone.
         self.write_lens_files("FR", ["GPFR0003.png"], [make_raw(54)], 0)
         refused = self.path("refused")
-        result = run_colmap("dual_fisheye_splitter",
-                            "--front_path", self.path("FR"),
-                            "--back_path", self.path("BK"),
-                            "--output_path", refused,
-                            "--circles", circles_arg(CIRCLES), check=False)
+        result = self.split_folders("FR", "BK", refused,
+                                    "--circles", circles_arg(CIRCLES),
+                                    check=False)
         self.assertNotEqual(result.returncode, 0)
         self.assertIn("frame GP0003.png", result.stdout)
         self.assertIn("no file of the back lens", result.stdout)
         self.assertIn("--allow_incomplete_frames", result.stdout)
         self.assertFalse(os.path.exists(refused))
         output = self.path("out_incomplete")
-        result = run_colmap("dual_fisheye_splitter",
-                            "--front_path", self.path("FR"),
-                            "--back_path", self.path("BK"),
-                            "--output_path", output,
-                            "--circles", circles_arg(CIRCLES),
-                            "--allow_incomplete_frames", "1")
+        result = self.split_folders("FR", "BK", output,
+                                    "--circles", circles_arg(CIRCLES),
+                                    "--allow_incomplete_frames", "1")
         self.assertIn("4 raw frames -> 7 lens images", result.stdout)
         self.assertTrue(os.path.exists(os.path.join(
             output, "images", "lens0", "GP0003.png")))
@@ -424,11 +423,9 @@ class DualFisheyeSplitterTest(TempDirTestCase):
         photo = rng.integers(20, 256, size=raws[0].shape, dtype=np.uint8)
         self.write_lens_files("pFR", ["x.png"], [photo], 0)
         self.write_lens_files("pBK", ["x.png"], [photo], 1)
-        result = run_colmap("dual_fisheye_splitter",
-                            "--front_path", self.path("pFR"),
-                            "--back_path", self.path("pBK"),
-                            "--output_path", refused,
-                            "--circles", circles_arg(CIRCLES), check=False)
+        result = self.split_folders("pFR", "pBK", refused,
+                                    "--circles", circles_arg(CIRCLES),
+                                    check=False)
         self.assertNotEqual(result.returncode, 0)
         self.assertIn("x.png: lens 0: only", result.stdout)
         self.assertIn("not a dual-fisheye frame", result.stdout)
