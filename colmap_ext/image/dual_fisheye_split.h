@@ -119,27 +119,34 @@ std::string DualFisheyeFrameError(const std::array<cv::Mat, 2>& lens_images,
 // ends and the lens's dark edge, housing or black surround begins; none of
 // these need be black, and the circle may reach past the image's edges.
 //
+// The intensity is blurred (sigma max(1 px, 0.1% of the smaller side)).
 // Along 720 rays from the image's centre, the places where the mean
 // intensity over a window (1% of the image's smaller side, at least 2 px)
 // before a point exceeds that after it by the most (local maxima, located
 // to a fraction of a pixel), and the outside is at most 60% of the inside,
 // are edge candidates (the 4 strongest a ray). A circle is found among them
-// by RANSAC (3 candidates of different rays; the score is the summed edge
-// strength of the candidates within max(1.5 px, 0.3% of r) of the circle,
-// so that the strong edge of the image circle beats the weak outer edge of
-// a housing), fitted to its inliers by least squares (Kasa) with outliers
-// dropped, and then refined twice from rays cast from its own centre (the
-// strongest edge within a band around the circle a ray). Scene edges, a
-// housing ring and flare are outliers. When the surround is black, so that
-// the circle bounding the pixels brighter than BLACK_LEVEL agrees with the
-// edge within max(2 px, 1% of r), that circle is returned instead: a
-// hard-edged disc's own mask comes back pixel for pixel.
+// by RANSAC (3 candidates of different rays; a camera centres its circles,
+// so the centre within 20% of the smaller side of the image's centre and a
+// radius from 25% of the smaller side to the diagonal; the score is the
+// summed strength of the strongest candidate of each ray within max(1.5
+// px, 1% of r) of the circle, so that the strong edge of the image circle
+// beats the weak outer edge of a housing, and the tolerance takes the soft
+// edge of a real lens, whose steepest point moves with the brightness of
+// the picture at the rim), fitted to its inliers by least squares (Kasa),
+// refitted until the inliers no longer change, and then refined twice from
+// rays cast from its own centre (the strongest edge within a band of
+// max(3 windows, 3% of r) around the circle, a ray). Scene edges, a housing
+// ring and flare are outliers. When the surround is black, so that the
+// circle bounding the pixels brighter than BLACK_LEVEL agrees with the edge
+// within max(2 px, 1% of r), that circle is returned instead: a hard-edged
+// disc's own mask comes back pixel for pixel.
 //
-// Returns "" and sets *CIRCLE, or why no circle was found (too few edge
-// points, or those near the best circle cover too little of its visible
-// rim: less than half of the rays that cross it inside the image, or fewer
-// than 5 of 8 directions from its centre). The circle is not checked
-// against the image size (ImageCircleError does that).
+// Returns "" and sets *CIRCLE, or why no circle was found: too few edge
+// candidates, or the edges near the best circle cover too little of its
+// rim inside the image (fewer than 16 rays, less than half of the rays
+// that cross it inside the image, or less than 3/4 of the 45-degree
+// directions those rays are in, or fewer than 3). The circle is not
+// checked against the image size (ImageCircleError does that).
 std::string DetectImageCircle(const cv::Mat& lens_image,
                               int black_level,
                               ImageCircle* circle);
