@@ -997,6 +997,16 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
               << ShortestDoubleText(circles[lens].cx) << ", "
               << ShortestDoubleText(circles[lens].cy) << ", "
               << ShortestDoubleText(circles[lens].r) << ") " << origin.str();
+    // More than the edge's own uncertainty (1% of r): the circle moves.
+    if (!given_circles &&
+        LargestDeviation(scan.detected[lens], circles[lens]) >
+            0.01 * circles[lens].r) {
+      LOG(WARNING) << "dual_fisheye_splitter: " << lens_names[lens]
+                   << "'s image circle differs between frames by more than "
+                      "1% of its radius (a stabilised or cropped video, or "
+                      "frames of two cameras?); the median is used for "
+                      "every frame (--circles sets one)";
+    }
   }
 
   WriteOutputs(
