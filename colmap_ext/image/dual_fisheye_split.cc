@@ -479,16 +479,22 @@ bool PlausibleCircle(const ImageCircle& circle, const cv::Size& size) {
 bool StrongestCircle(const std::vector<EdgePoint>& points,
                      const cv::Size& size,
                      ImageCircle* best) {
-  constexpr int kNumIterations = 3000;
+  constexpr int kNumIterations = 6000;
   std::mt19937 random(12345);
   std::uniform_int_distribution<size_t> pick(0, points.size() - 1);
   double best_score = 0;
   std::vector<double> ray_strength(kNumRays);
+  // The three points at least 60 degrees apart round the image's centre: a
+  // triple bunched on one arc defines a circle poorly.
+  const auto apart = [](const EdgePoint& a, const EdgePoint& b) {
+    const int difference = std::abs(a.ray - b.ray);
+    return std::min(difference, kNumRays - difference) >= kNumRays / 6;
+  };
   for (int iteration = 0; iteration < kNumIterations; ++iteration) {
     const EdgePoint& a = points[pick(random)];
     const EdgePoint& b = points[pick(random)];
     const EdgePoint& c = points[pick(random)];
-    if (a.ray == b.ray || a.ray == c.ray || b.ray == c.ray) {
+    if (!apart(a, b) || !apart(a, c) || !apart(b, c)) {
       continue;
     }
     ImageCircle circle;

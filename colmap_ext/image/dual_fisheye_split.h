@@ -125,11 +125,12 @@ std::string DualFisheyeFrameError(const std::array<cv::Mat, 2>& lens_images,
 // before a point exceeds that after it by the most (local maxima, located
 // to a fraction of a pixel), and the outside is at most 60% of the inside,
 // are edge candidates (the 4 strongest a ray). A circle is found among them
-// by RANSAC (3 candidates of different rays; a camera centres its circles,
-// so the centre within 20% of the smaller side of the image's centre and a
-// radius from 25% of the smaller side to the diagonal; the score is the
-// summed strength of the strongest candidate of each ray within max(1.5
-// px, 1% of r) of the circle, so that the strong edge of the image circle
+// by RANSAC (6000 triples of candidates on rays at least 60 degrees apart,
+// a fixed seed; a camera centres its circles, so the centre within 20% of
+// the smaller side of the image's centre and a radius from 25% of the
+// smaller side to the diagonal; the score is the summed strength of the
+// strongest candidate of each ray within max(1.5 px, 1% of r) of the
+// circle, so that the strong edge of the image circle
 // beats the weak outer edge of a housing, and the tolerance takes the soft
 // edge of a real lens, whose steepest point moves with the brightness of
 // the picture at the rim), fitted to its inliers by least squares (Kasa),
