@@ -4,35 +4,13 @@
 #include "colmap/util/file.h"
 #include "colmap/util/logging.h"
 #include "colmap_ext/controllers/model_evaluation.h"
+#include "colmap_ext/util/file_output.h"
 
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
 
 namespace colmap {
-namespace {
-
-// Writes next to `path` and renames, so a failed run never leaves a file
-// that looks complete.
-void WriteFileAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp_path = path + ".tmp";
-  {
-    std::ofstream file(tmp_path, std::ios::trunc);
-    THROW_CHECK_FILE_OPEN(file, tmp_path);
-    file << text;
-    if (!file) {
-      throw std::runtime_error("cannot write " + tmp_path);
-    }
-  }
-  if (std::rename(tmp_path.c_str(), path.c_str()) != 0) {
-    throw std::runtime_error("cannot rename " + tmp_path + " to " + path);
-  }
-}
-
-}  // namespace
 
 int RunModelEvaluator(int argc, char** argv) {
   std::string gt_path;
@@ -55,6 +33,10 @@ int RunModelEvaluator(int argc, char** argv) {
                                "camera centres; orientations: rotation from "
                                "the camera orientations");
   if (!options.Parse(argc, argv)) {
+    return EXIT_FAILURE;
+  }
+  if (const std::string error = evaluation_options.Check(); !error.empty()) {
+    LOG(ERROR) << "model_evaluator: " << error;
     return EXIT_FAILURE;
   }
 
@@ -145,13 +127,10 @@ int RunModelEvaluator(int argc, char** argv) {
           << image.position_error_normalized << "\n";
     }
     try {
-      WriteFileAtomically(
-          (std::filesystem::path(output_path) / "evaluation.json").string(),
-          ModelEvaluationToJson(evaluation));
-      WriteFileAtomically(
-          (std::filesystem::path(output_path) / "evaluation_images.csv")
-              .string(),
-          csv.str());
+      WriteTextFilesAtomically(
+          output_path,
+          {{"evaluation.json", ModelEvaluationToJson(evaluation)},
+           {"evaluation_images.csv", csv.str()}});
     } catch (const std::exception& error) {
       LOG(ERROR) << "model_evaluator: " << error.what();
       return EXIT_FAILURE;

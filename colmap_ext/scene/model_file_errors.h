@@ -3,6 +3,7 @@
 #pragma once
 
 #include "colmap/scene/reconstruction.h"
+#include "colmap_ext/util/file_output.h"
 
 #include <algorithm>
 #include <cmath>
@@ -49,33 +50,6 @@ inline void CheckCountFits(std::istream& stream, uint64_t count,
     throw std::runtime_error(what + " is " + std::to_string(count) +
                              ", more than the " + std::to_string(left) +
                              " bytes left in the file can hold");
-  }
-}
-
-// Writes the files of a model into the folder `path`: each first under its
-// name + ".tmp", and only when all are written are they renamed to their
-// names, so that a run killed while writing (or a write that fails) leaves
-// the model that was there. files: (file name, write(file path)).
-inline void WriteModelFiles(
-    const std::filesystem::path& path,
-    const std::vector<std::pair<std::string,
-                                std::function<void(const std::filesystem::path&)>>>&
-        files) {
-  std::vector<std::filesystem::path> written;
-  try {
-    for (const auto& [name, write] : files) {
-      written.push_back(path / (name + ".tmp"));
-      write(written.back());
-    }
-  } catch (...) {
-    std::error_code ignored;
-    for (const auto& tmp : written) {
-      std::filesystem::remove(tmp, ignored);
-    }
-    throw;
-  }
-  for (size_t i = 0; i < files.size(); ++i) {
-    std::filesystem::rename(written[i], path / files[i].first);
   }
 }
 
