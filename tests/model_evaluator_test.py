@@ -5,6 +5,7 @@ import math
 import os
 import random
 import shutil
+import struct
 
 from cli_util import SHARED_DATA, TempDirTestCase
 from sphera_common import (axis_angle_quat, pose_errors, quat_mul,
@@ -226,6 +227,54 @@ class ModelEvaluatorTest(TempDirTestCase):
         self.assertIn("at least 3", result.stdout)
         self.assertFalse(os.path.exists(self.path("out", "evaluation.json")))
 
+    def test_negative_or_non_finite_threshold_is_named(self):
+        write_model(self.path("gt"), ground_truth_poses())
+        os.makedirs(self.path("out"))
+        for value in ("-1", "nan", "inf"):
+            with self.subTest(value=value):
+                result = run_colmap(
+                    "model_evaluator", "--gt_path", self.path("gt"),
+                    "--input_path", self.path("gt"), "--output_path",
+                    self.path("out"), "--max_proj_center_error", value,
+                    check=False)
+                self.assertEqual(result.returncode, 1, result.stdout)
+                self.assertIn("max_proj_center_error", result.stdout)
+                self.assertEqual(os.listdir(self.path("out")), [])
+
+    def test_damaged_depth_maps_are_named(self):
+        # Range maps of the ground truth's 64x32 images: one holding a NaN,
+        # one a negative range, one of another size; each is named with its
+        # file, and no evaluation is written.
+        write_model(self.path("gt"), ground_truth_poses(),
+                    model_line="EQUIRECTANGULAR 64 32 64 32")
+        os.makedirs(self.path("out"))
+        cases = (("nan", (64, 32), float("nan"), "range nan"),
+                 ("negative", (64, 32), -2.0, "range -2"),
+                 ("size", (32, 16), 1.0, "is 32x16"))
+        for tag, (width, height), bad, reason in cases:
+            with self.subTest(case=tag):
+                depth = self.path(f"depth_{tag}")
+                os.makedirs(depth)
+                for i in range(9):
+                    ranges = [2.0] * (width * height)
+                    if i == 4:
+                        ranges[width * 3 + 5] = bad
+                    with open(os.path.join(depth, f"view{i}.jpg.depth.bin"),
+                              "wb") as f:
+                        f.write(struct.pack("<2i", width, height))
+                        f.write(struct.pack(f"<{len(ranges)}f", *ranges))
+                result = run_colmap(
+                    "model_evaluator", "--gt_path", self.path("gt"),
+                    "--input_path", self.path("gt"), "--output_path",
+                    self.path("out"), "--depth_path", depth, check=False)
+                self.assertEqual(result.returncode, 1, result.stdout)
+                self.assertIn(reason, result.stdout)
+                # Every map of the size case is wrong; the first read is
+                # named, whichever it is.
+                self.assertIn("view4.jpg.depth.bin" if tag != "size"
+                              else ".jpg.depth.bin", result.stdout)
+                self.assertEqual(os.listdir(self.path("out")), [])
+
     def test_malformed_model_fails_cleanly(self):
         write_model(self.path("gt"), ground_truth_poses())
         write_model(self.path("estimate"), ground_truth_poses())
@@ -344,6 +393,36 @@ class StrechaImporterTest(TempDirTestCase):
                 self.assertIn(f"c.jpg.camera:{line + 1}", result.stdout)
                 self.assertIn("finite", result.stdout)
                 self.assertEqual(os.listdir(self.path(f"model{line}")), [])
+
+    def test_absurd_sizes_and_matrices_are_named(self):
+        # A huge, a fractional and a zero image size; K not upper
+        # triangular, not normalised, with a negative focal length, with its
+        # principal point far outside the image: each names its file and
+        # what is wrong, and nothing is written.
+        valid = ["1000 0 500", "0 1100 400", "0 0 1", "0 0 0", "0 -1 0",
+                 "1 0 0", "0 0 1", "1 2 3", "1000 800"]
+        cases = ((8, "1000000000 800", "outside"),
+                 (8, "1000.5 800", "whole number"),
+                 (8, "1000 0", "outside"),
+                 (2, "0 0.3 1", "upper triangular"),
+                 (2, "0 0 2", "normalised"),
+                 (0, "-1000 0 500", "positive"),
+                 (1, "0 1100 90000", "outside the 1000x800 image"))
+        for index, (line, value, reason) in enumerate(cases):
+            with self.subTest(value=value):
+                shutil.rmtree(self.path("cams"), ignore_errors=True)
+                lines = list(valid)
+                lines[line] = value
+                self.write_camera("c.jpg", "\n".join(lines) + "\n")
+                out = self.path(f"model{index}")
+                os.makedirs(out)
+                result = run_colmap("strecha_importer", "--input_path",
+                                    self.path("cams"), "--output_path", out,
+                                    check=False)
+                self.assertEqual(result.returncode, 1, result.stdout)
+                self.assertIn("c.jpg.camera", result.stdout)
+                self.assertIn(reason, result.stdout)
+                self.assertEqual(os.listdir(out), [])
 
     @unittest.skipUnless(os.path.isdir(FOUNTAIN), "needs ../shared/data")
     def test_fountain_ground_truth_imports(self):

@@ -10,6 +10,7 @@
 #include "estimators/similarity_alignment.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -29,23 +30,42 @@ struct DepthMap {
   int height = 0;
   std::vector<float> ranges;
 
-  bool Read(const std::string& path) {
+  // Empty, or why the file at `path` is not the range map of an image of
+  // `camera`'s size: unreadable, another size, short, or a range that is
+  // negative or not finite (a damaged file would bias every point error).
+  std::string Read(const std::string& path, const Camera& camera) {
     std::ifstream file(path, std::ios::binary);
     if (!file) {
-      return false;
+      return "cannot be read";
     }
     int32_t size[2];
     file.read(reinterpret_cast<char*>(size), sizeof(size));
-    if (!file || size[0] <= 0 || size[1] <= 0 ||
-        static_cast<int64_t>(size[0]) * size[1] > (int64_t{1} << 31)) {
-      return false;
+    if (!file) {
+      return "is shorter than its 8-byte header";
+    }
+    if (size[0] != static_cast<int64_t>(camera.width) ||
+        size[1] != static_cast<int64_t>(camera.height)) {
+      return "is " + std::to_string(size[0]) + "x" + std::to_string(size[1]) +
+             ", its image " + std::to_string(camera.width) + "x" +
+             std::to_string(camera.height);
     }
     width = size[0];
     height = size[1];
     ranges.resize(static_cast<size_t>(width) * height);
     file.read(reinterpret_cast<char*>(ranges.data()),
               ranges.size() * sizeof(float));
-    return static_cast<bool>(file);
+    if (!file) {
+      return "holds fewer than its " + std::to_string(ranges.size()) +
+             " ranges";
+    }
+    for (size_t i = 0; i < ranges.size(); ++i) {
+      if (!std::isfinite(ranges[i]) || ranges[i] < 0) {
+        return "has the range " + std::to_string(ranges[i]) + " at pixel (" +
+               std::to_string(i % width) + ", " + std::to_string(i / width) +
+               ")";
+      }
+    }
+    return "";
   }
 
   // Range along the ray through `point2D`: bilinear between the four
@@ -158,8 +178,11 @@ ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
                      static_cast<int>(common_image_ids.size())));
   }
 
+  if (const std::string error = options.Check(); !error.empty()) {
+    throw std::invalid_argument(error);
+  }
   double max_proj_center_error = options.max_proj_center_error;
-  if (max_proj_center_error <= 0) {
+  if (max_proj_center_error == 0) {
     max_proj_center_error = 0.05 * LargestBaseline(ground_truth);
   }
   if (!(max_proj_center_error > 0)) {
@@ -222,6 +245,7 @@ ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
     }
   }
 
+  evaluation.gt_from_reconstruction = gt_from_reconstruction;
   evaluation.closest_pair_baseline = ClosestPairBaseline(ground_truth);
   const std::vector<ImageAlignmentError> alignment_errors =
       ComputeImageAlignmentError(
@@ -286,8 +310,12 @@ ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
       const std::string depth_file =
           (std::filesystem::path(options.depth_path) / (name + ".depth.bin"))
               .string();
-      if (!depth_map.Read(depth_file)) {
-        throw std::invalid_argument("cannot read depth map " + depth_file);
+      const Camera& camera =
+          ground_truth.Camera(ground_truth.Image(image_id).CameraId());
+      if (const std::string error = depth_map.Read(depth_file, camera);
+          !error.empty()) {
+        throw std::invalid_argument("--depth_path: depth map " + depth_file +
+                                    " " + error);
       }
       depth_maps.emplace(name, std::move(depth_map));
       gt_image_ids.emplace(name, image_id);
@@ -324,6 +352,15 @@ ModelEvaluation EvaluateModel(const Reconstruction& ground_truth,
     }
   }
   return evaluation;
+}
+
+std::string ModelEvaluationOptions::Check() const {
+  if (!(max_proj_center_error >= 0) || !std::isfinite(max_proj_center_error)) {
+    return "--max_proj_center_error must be >= 0 (0: 5% of the largest "
+           "ground-truth baseline), got " +
+           std::to_string(max_proj_center_error);
+  }
+  return "";
 }
 
 std::string AlignmentName(ModelAlignment alignment) {

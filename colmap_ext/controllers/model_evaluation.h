@@ -3,6 +3,7 @@
 // and, with sphera_render's range maps, the 3D point error.
 #pragma once
 
+#include "colmap/geometry/sim3.h"
 #include "colmap/scene/reconstruction.h"
 #include "colmap/util/enum_utils.h"
 
@@ -24,12 +25,15 @@ MAKE_ENUM_CLASS_OVERLOAD_STREAM(ModelAlignment, 0, CENTERS, ORIENTATIONS);
 struct ModelEvaluationOptions {
   ModelAlignment alignment = ModelAlignment::CENTERS;
   // Inlier threshold of the robust similarity on camera centres, in ground
-  // truth units; <= 0 picks 5% of the largest distance between ground-truth
-  // camera centres.
-  double max_proj_center_error = -1;
+  // truth units, >= 0; 0 picks 5% of the largest distance between
+  // ground-truth camera centres.
+  double max_proj_center_error = 0;
   // Folder with the ground-truth range maps NAME.depth.bin (sphera_render's
   // format); empty skips the 3D point error.
   std::string depth_path;
+
+  // Empty, or why an option is out of its range (naming the option).
+  std::string Check() const;
 };
 
 struct ImageEvaluation {
@@ -50,6 +54,8 @@ struct CameraEvaluation {
 
 struct ModelEvaluation {
   ModelAlignment alignment = ModelAlignment::CENTERS;
+  // The similarity that maps the reconstruction onto the ground truth.
+  Sim3d gt_from_reconstruction;
   size_t num_gt_images = 0;
   size_t num_registered = 0;
   size_t num_points3D = 0;

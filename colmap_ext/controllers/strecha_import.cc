@@ -3,6 +3,8 @@
 #include "colmap/util/logging.h"
 #include "colmap/util/string.h"
 
+#include "camera_models/intrinsics_check.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -93,9 +95,10 @@ Reconstruction ReadStrechaCameras(const std::string& camera_path) {
     }
     const std::vector<double> center = ReadNumbers(file, path, &line_number, 3);
     const std::vector<double> size = ReadNumbers(file, path, &line_number, 2);
-    if (K(0, 0) <= 0 || K(1, 1) <= 0 || size[0] < 1 || size[1] < 1) {
-      throw std::invalid_argument(path + ": focal lengths and image size "
-                                         "must be positive");
+    if (std::string error = sphera::ImageSizeError(size[0], size[1]);
+        !error.empty() ||
+        !(error = sphera::PinholeMatrixError(K, size[0], size[1])).empty()) {
+      throw std::invalid_argument(path + ": " + error);
     }
     if (std::abs(world_from_cam_rotation.determinant() - 1) > 1e-3) {
       throw std::invalid_argument(path + ": R is not a rotation");
