@@ -1,22 +1,25 @@
-# Sources of colmap_ext/controllers/ and image/ (and scene/camera_params_error)
-# that the patch series compiles into COLMAP's colmap_controllers library (the
-# mapper and the commands call them), and what they link. Included before
-# COLMAP's CMake files are read.
+# Sources of colmap_ext/controllers/ and image/ that the patch series
+# compiles into COLMAP's colmap_controllers library (the mapper and the
+# commands call them), and what they link. Included before COLMAP's CMake
+# files are read.
 find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs)
 set(SPHERA_COLMAP_CONTROLLER_SRCS
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/dual_fisheye_splitting.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/image_errors.cc
   ${CMAKE_CURRENT_LIST_DIR}/image/dual_fisheye_split.cc
   ${CMAKE_CURRENT_LIST_DIR}/image/image_file_structure.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/mapper_report.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/model_evaluation.cc
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/rig_calibration.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_bundle_adjustment.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_undistortion.cc
-  ${CMAKE_CURRENT_LIST_DIR}/controllers/strecha_import.cc
-  ${CMAKE_CURRENT_LIST_DIR}/scene/camera_params_error.cc)
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/strecha_import.cc)
 # Sources of colmap_ext/scene/ that the patch series compiles into COLMAP's
-# colmap_scene library (the database opens through them; the mapper, in
-# colmap_sfm above it, checks refined intrinsics with them).
+# colmap_scene library (the database opens through them and checks its
+# cameras; the mapper, in colmap_sfm above it, checks refined intrinsics
+# with them).
 set(SPHERA_COLMAP_SCENE_SRCS
+  ${CMAKE_CURRENT_LIST_DIR}/scene/camera_params_error.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/database_check.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/intrinsics_divergence.cc)
 set(SPHERA_COLMAP_CONTROLLER_LIBS

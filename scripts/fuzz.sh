@@ -25,6 +25,9 @@
 #   fuzz_rig_config      rig_configurator's JSON reader as patched
 #                        (colmap/scene/rig.cc instrumented, the rest linked
 #                        as for fuzz_model_readers)
+#   fuzz_calibration_import  calibration_importer's readers of Kalibr,
+#                        OpenCV, OCamCalib and Basalt files (calibration/,
+#                        instrumented; yaml-cpp, OpenCV and Ceres from Debian)
 #
 # Each target starts from seeds made here from a rendered scene (a small
 # database of two images, a JPEG and a PNG; a small valid model in both
@@ -42,7 +45,8 @@ readonly WORK="${BUILD_DIR}/fuzz"
 readonly COLMAP="${BUILD_DIR}/bin/colmap"
 readonly RENDER="${BUILD_DIR}/synthetic/sphera_render"
 readonly ALL_TARGETS=(fuzz_database_check fuzz_image_bytes fuzz_camera_params
-                      fuzz_model_readers fuzz_rig_config)
+                      fuzz_model_readers fuzz_rig_config
+                      fuzz_calibration_import)
 # COLMAP's log lines of every rejected input would cost most of the time.
 export GLOG_minloglevel=3
 
@@ -88,11 +92,13 @@ build_target() {
   local target="$1" sources=()
   local scene="${BUILD_DIR}/colmap-src/src/colmap/scene"
   case "${target}" in
-    fuzz_database_check)
-      sources=("${REPO_ROOT}/colmap_ext/scene/database_check.cc" -lsqlite3) ;;
     fuzz_image_bytes)
       sources=("${REPO_ROOT}/colmap_ext/image/image_file_structure.cc") ;;
-    fuzz_camera_params|fuzz_model_readers|fuzz_rig_config)
+    fuzz_calibration_import)
+      # shellcheck disable=SC2207
+      sources=($(ls "${REPO_ROOT}"/calibration/*.cc | grep -v _test.cc)
+               -I /usr/include/opencv4 -lopencv_core -lyaml-cpp -lceres -lglog) ;;
+    fuzz_database_check|fuzz_camera_params|fuzz_model_readers|fuzz_rig_config)
       # The sources under test instrumented, the rest of COLMAP linked from
       # the build with the flags of one of its objects.
       local object="build colmap/src/colmap/scene/CMakeFiles/colmap_scene.dir/reconstruction_io_binary.cc.o:"
@@ -100,6 +106,9 @@ build_target() {
       local own=("${scene}/reconstruction_io_binary.cc"
                  "${scene}/reconstruction_io_text.cc")
       [ "${target}" = fuzz_rig_config ] && own=("${scene}/rig.cc")
+      [ "${target}" = fuzz_database_check ] && own=(
+          "${REPO_ROOT}/colmap_ext/scene/database_check.cc"
+          "${REPO_ROOT}/colmap_ext/scene/camera_params_error.cc")
       [ "${target}" = fuzz_camera_params ] && own=(
           "${REPO_ROOT}/colmap_ext/controllers/image_errors.cc"
           "${REPO_ROOT}/colmap_ext/scene/camera_params_error.cc"
@@ -116,6 +125,7 @@ build_target() {
   newest="$(ls -t "${REPO_ROOT}/tests/fuzz/${target}.cc" \
             "${REPO_ROOT}"/colmap_ext/scene/*.h "${REPO_ROOT}"/colmap_ext/scene/*.cc \
             "${REPO_ROOT}"/colmap_ext/image/image_file_structure.* \
+            "${REPO_ROOT}"/calibration/* \
             "$(readlink -f "${COLMAP}")" "${binary}" 2>/dev/null | head -1 || true)"
   if [ ! -x "${binary}" ] || [ "${newest}" != "${binary}" ]; then
     log "building ${target}"
@@ -203,8 +213,70 @@ EOF
   echo 2 > "${seeds}/done"
 }
 
+# Seeds of fuzz_calibration_import: a small file of each format behind the
+# byte that names it (0 Kalibr, 1 OpenCV, 2 OCamCalib, 3 Basalt); written
+# every run, outside make_seeds' versioned recipe.
+make_calibration_seeds() {
+  local seeds="${WORK}/seeds/fuzz_calibration_import"
+  mkdir -p "${seeds}"
+  printf '\000%s' 'cam0:
+  camera_model: pinhole
+  intrinsics: [458.6, 457.3, 367.2, 248.4]
+  distortion_model: radtan
+  distortion_coeffs: [-0.28, 0.07, 0.0002, 0.00002]
+  resolution: [752, 480]
+cam1:
+  T_cn_cnm1:
+  - [0.0, 0.0, 1.0, 0.1]
+  - [0.0, 1.0, 0.0, 0.0]
+  - [-1.0, 0.0, 0.0, 0.0]
+  - [0.0, 0.0, 0.0, 1.0]
+  camera_model: ds
+  intrinsics: [-0.2, 0.6, 300.0, 300.0, 511.5, 511.5]
+  distortion_model: none
+  distortion_coeffs: []
+  resolution: [1024, 1024]
+' > "${seeds}/kalibr"
+  printf '\001%s' '%YAML:1.0
+---
+image_width: 640
+image_height: 480
+fisheye_model: 1
+camera_matrix: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 200., 0., 319.5, 0., 201., 239.5, 0., 0., 1. ]
+distortion_coefficients: !!opencv-matrix
+   rows: 4
+   cols: 1
+   dt: d
+   data: [ 0.02, -0.005, 0.0009, -0.0001 ]
+' > "${seeds}/opencv"
+  printf '\002%s' '#polynomial coefficients
+5 -250 0 1.2e-3 -1e-6 2e-9
+#inverse polynomial
+3 250 100 10
+#center
+239.25 319.75
+#affine parameters
+1.0005 0.0002 -0.0001
+#image size
+480 640
+' > "${seeds}/ocamcalib"
+  printf '\003%s' '{"value0": {"T_imu_cam": [
+ {"px": 0.01, "py": 0, "pz": 0, "qx": 0, "qy": 0, "qz": 0, "qw": 1},
+ {"px": -0.09, "py": 0, "pz": 0, "qx": 0, "qy": 0.7071067811865476, "qz": 0, "qw": 0.7071067811865476}],
+ "intrinsics": [
+ {"camera_type": "kb4", "intrinsics": {"fx": 380, "fy": 381, "cx": 319.5, "cy": 239.5, "k1": 0.01, "k2": -0.002, "k3": 0.0004, "k4": -0.00005}},
+ {"camera_type": "ucm", "intrinsics": {"fx": 300, "fy": 300, "cx": 319.5, "cy": 239.5, "alpha": 0.6}}],
+ "resolution": [[640, 480], [640, 480]]}}
+' > "${seeds}/basalt"
+}
+
 # -- run --------------------------------------------------------------------
 make_seeds
+make_calibration_seeds
 for target in "${targets[@]}"; do
   build_target "${target}"
 done

@@ -233,6 +233,27 @@ DAMAGED_DATABASES = [
     ("camera param NaN", sql_damage(
         "UPDATE cameras SET params = x'000000000000f87f' || substr(params, 9)")),
     ("camera width 0", sql_damage("UPDATE cameras SET width = 0")),
+    # The first keypoint of image 1 (x, y, a11, a12, a21, a22 as float32).
+    ("keypoint x NaN", sql_damage(
+        "UPDATE keypoints SET data = x'0000c07f' || substr(data, 5) "
+        "WHERE image_id = 1")),
+    ("keypoint shape infinite", sql_damage(
+        "UPDATE keypoints SET data = substr(data, 1, 8) || x'0000807f' || "
+        "substr(data, 13) WHERE image_id = 1")),
+    ("keypoint far outside the image", sql_damage(
+        "UPDATE keypoints SET data = x'00247449' || substr(data, 5) "
+        "WHERE image_id = 1")),
+    # A second row of image 1 without keypoints, in a table whose UNIQUE
+    # constraint was lost.
+    ("two images of one name", sql_damage(
+        "CREATE TABLE images_copy AS SELECT * FROM images",
+        "DROP TABLE images", "ALTER TABLE images_copy RENAME TO images",
+        "INSERT INTO images SELECT 99, name, camera_id FROM images "
+        "WHERE image_id = 1")),
+    # EQUIRECTANGULAR w,h = 640,320 for a camera of 320x240 images.
+    ("equirectangular w,h other than the image size", sql_damage(
+        "UPDATE cameras SET model = 17, "
+        "params = x'00000000000084400000000000007440'")),
     ("image of a missing camera", sql_damage(
         "UPDATE images SET camera_id = 77 WHERE image_id = 2")),
     ("frame of a missing image", sql_damage(
@@ -493,6 +514,29 @@ class BadOptionTest(BadInputCase):
                 self.assertEqual(database_state(database), before, case)
                 self.assertEqual(os.listdir(out), [], case)
         self.assertEqual(len(BAD_OPTIONS), 30)
+
+    def test_sphere_bundle_adjuster_enums_in_any_letter_case(self):
+        """Its --mode, --residual and --loss take the enum names in any
+        letter case, as COLMAP's own enum options; another word is named."""
+        for index, values in enumerate((
+                ["--mode", "CAMERA_ONLY"],
+                ["--mode", "full", "--residual", "Pixel", "--loss", "cauchy"])):
+            out = self.path(f"ba{index}")
+            os.makedirs(out)
+            code, output = run_bounded(
+                ["sphere_bundle_adjuster", "--input_path", Scene.model,
+                 "--output_path", out] + values)
+            self.assertEqual(code, 0, output[-2500:])
+            self.assertIn("images.bin", os.listdir(out))
+        for option in ("--mode", "--residual", "--loss"):
+            out = self.path(f"ba_bad{option}")
+            os.makedirs(out)
+            code, output = run_bounded(
+                ["sphere_bundle_adjuster", "--input_path", Scene.model,
+                 "--output_path", out, option, "nonsense"])
+            self.assert_named_error(code, output, [option, "nonsense"],
+                                    option, internal_checks=True)
+            self.assertEqual(os.listdir(out), [], option)
 
     def test_bad_paths_are_named_errors(self):
         missing = self.path("does_not_exist")

@@ -1,6 +1,8 @@
 #include "colmap_ext/scene/database_check.h"
 
+#include "colmap/scene/camera.h"
 #include "colmap/sensor/models.h"
+#include "colmap_ext/scene/camera_params_error.h"
 #include "colmap/util/types.h"
 
 #include <algorithm>
@@ -51,6 +53,11 @@ const char* const kCoreTables[] = {
 constexpr int kSiftType = 0;  // FeatureExtractorType::SIFT
 constexpr int kCameraSensor = static_cast<int>(SensorType::CAMERA);
 constexpr int kMaxConfig = 9;  // TwoViewGeometry::CALIBRATED_RIG
+
+// How far outside its image a keypoint may lie, in pixels: detectors place
+// keypoints up to about half a pixel outside the pixel grid (COLMAP's pixel
+// centres are at +0.5); any farther is damage, not a feature at the border.
+double KeypointMargin(int64_t size) { return 2.0 + 0.01 * size; }
 
 class ReadOnlyDatabase {
  public:
@@ -260,7 +267,18 @@ class DatabaseChecker {
                        Str(params[i]));
             }
           }
-          cameras_.insert(camera_id);
+          // Parameters that contradict the image size (an equirectangular
+          // w,h other than width x height) or their model's validity.
+          Camera camera;
+          camera.model_id = model_id;
+          camera.width = static_cast<size_t>(Int(stmt, 2));
+          camera.height = static_cast<size_t>(Int(stmt, 3));
+          camera.params = std::move(params);
+          if (const std::string error = CameraParamsError(camera);
+              !error.empty()) {
+            db_.Fail(row + error);
+          }
+          cameras_[camera_id] = {Int(stmt, 2), Int(stmt, 3)};
         });
   }
 
@@ -274,7 +292,17 @@ class DatabaseChecker {
                            ") refers to camera " + Str(Int(stmt, 2)) +
                            ", which is not in the cameras table");
                 }
+                if (images_.count(image_id)) {
+                  db_.Fail("image " + Str(image_id) + " has two rows (" +
+                           images_.at(image_id) + " and " + name + ")");
+                }
+                if (const auto [it, inserted] = image_ids_.emplace(name, image_id);
+                    !inserted) {
+                  db_.Fail("images " + Str(it->second) + " and " +
+                           Str(image_id) + " have the same name " + name);
+                }
                 images_.emplace(image_id, name);
+                image_cameras_.emplace(image_id, Int(stmt, 2));
               });
   }
 
@@ -303,6 +331,37 @@ class DatabaseChecker {
     }
   }
 
+  // Every value finite (location, scale and orientation or affine shape),
+  // every location inside the image of the image's camera, give or take
+  // KeypointMargin: a NaN or a far-off keypoint would make matching and
+  // mapping compute on garbage (or never converge).
+  void CheckKeypointValues(const std::string& row, int64_t image_id,
+                           int64_t rows, int64_t cols,
+                           const char* data) const {
+    const auto& [width, height] = cameras_.at(image_cameras_.at(image_id));
+    const double margin_x = KeypointMargin(width);
+    const double margin_y = KeypointMargin(height);
+    for (int64_t k = 0; k < rows; ++k) {
+      float values[6];  // the blob need not be aligned
+      std::memcpy(values, data + k * cols * sizeof(float),
+                  cols * sizeof(float));
+      for (int64_t c = 0; c < cols; ++c) {
+        if (!std::isfinite(values[c])) {
+          db_.Fail(row + "keypoint " + Str(k) + " has the value " +
+                   Str(values[c]) + " in column " + Str(c + 1));
+        }
+      }
+      const double x = values[0], y = values[1];
+      if (x < -margin_x || x > width + margin_x || y < -margin_y ||
+          y > height + margin_y) {
+        db_.Fail(row + "keypoint " + Str(k) + " at (" + Str(x) + ", " +
+                 Str(y) + ") lies outside the " + Str(width) + "x" +
+                 Str(height) + " image of camera " +
+                 Str(image_cameras_.at(image_id)));
+      }
+    }
+  }
+
   void CheckFeatures() {
     auto& num_keypoints = num_keypoints_;
     db_.Query("SELECT image_id, rows, cols, data FROM keypoints;",
@@ -315,6 +374,9 @@ class DatabaseChecker {
                            " columns (a keypoint has 2, 4 or 6 values)");
                 }
                 CheckMatrix(row, rows, cols, Bytes(stmt, 3), sizeof(float));
+                CheckKeypointValues(row, image_id, rows, cols,
+                                    static_cast<const char*>(
+                                        sqlite3_column_blob(stmt, 3)));
                 num_keypoints[image_id] = rows;
               });
     std::set<std::string> columns;
@@ -472,8 +534,11 @@ class DatabaseChecker {
   ReadOnlyDatabase db_;
   const int format_version_;
   std::set<std::string> tables_;
-  std::unordered_set<int64_t> cameras_;
+  // Camera id -> image width and height.
+  std::unordered_map<int64_t, std::pair<int64_t, int64_t>> cameras_;
   std::unordered_map<int64_t, std::string> images_;
+  std::unordered_map<int64_t, int64_t> image_cameras_;
+  std::unordered_map<std::string, int64_t> image_ids_;
   std::unordered_map<int64_t, int64_t> num_keypoints_;
 };
 
@@ -665,6 +730,13 @@ std::string MissingPaths(int argc, const char* const* argv) {
     if (option.rfind("--", 0) != 0 || suffix == std::string::npos ||
         suffix + 5 != option.size() || value.empty() ||
         std::filesystem::exists(value, error)) {
+      continue;
+    }
+    // An output path in an existing folder is one the command would create.
+    if (option.size() >= 13 &&
+        option.compare(option.size() - 11, 11, "output_path") == 0 &&
+        std::filesystem::is_directory(
+            std::filesystem::absolute(value, error).parent_path(), error)) {
       continue;
     }
     missing += (missing.empty() ? "paths that do not exist: " : ", ") +

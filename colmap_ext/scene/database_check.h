@@ -58,7 +58,8 @@ std::string NoVerifiedPairError(const std::filesystem::path& path,
 
 // Empty, or "paths that do not exist: --OPTION PATH, ..." for the options
 // of ARGS named *_path whose value is not in the file system (said after a
-// command failed, whichever path made it fail).
+// command failed, whichever path made it fail); an *output_path in an
+// existing folder is not missing (the command would create it).
 std::string MissingPaths(int argc, const char* const* argv);
 
 }  // namespace colmap
