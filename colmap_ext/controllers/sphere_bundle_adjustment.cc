@@ -34,64 +34,22 @@ namespace {
 using Options = SphereBundleAdjustmentOptions;
 
 ////////////////////////////////////////////////////////////////////////////////
-// Option spellings
+// Option values
 ////////////////////////////////////////////////////////////////////////////////
 
+// Empty string, or the message for --`option` holding a value outside its
+// enum (a caller that set the field from an integer).
 template <typename E>
-struct EnumName {
-  E value;
-  const char* name;
-};
-
-constexpr EnumName<Options::Mode> kModeNames[] = {
-    {Options::Mode::CAMERA_ONLY, "camera_only"}, {Options::Mode::FULL, "full"}};
-constexpr EnumName<Options::Residual> kResidualNames[] = {
-    {Options::Residual::ANGULAR, "angular"},
-    {Options::Residual::PIXEL, "pixel"}};
-constexpr EnumName<Options::Loss> kLossNames[] = {
-    {Options::Loss::NONE, "none"}, {Options::Loss::CAUCHY, "cauchy"}};
-
-template <typename E, size_t N>
-const char* NameOf(const EnumName<E> (&names)[N], const E value) {
-  for (const EnumName<E>& entry : names) {
-    if (entry.value == value) return entry.name;
+std::string CheckEnum(const std::string& option,
+                      const E value,
+                      std::string_view (*to_string)(E)) {
+  try {
+    to_string(value);
+    return "";
+  } catch (const std::runtime_error&) {
+    return "--" + option + ": " + std::to_string(static_cast<int>(value)) +
+           " is none of its values";
   }
-  return nullptr;
-}
-
-template <typename E, size_t N>
-std::string Choices(const EnumName<E> (&names)[N]) {
-  std::string text;
-  for (size_t i = 0; i < N; ++i) {
-    if (i > 0) text += (i + 1 == N) ? " or " : ", ";
-    text += names[i].name;
-  }
-  return text;
-}
-
-// Empty string, or the message for the option --`option`.
-template <typename E, size_t N>
-std::string ParseName(const EnumName<E> (&names)[N],
-                      const std::string& option,
-                      const std::string& text,
-                      E* value) {
-  for (const EnumName<E>& entry : names) {
-    if (text == entry.name) {
-      *value = entry.value;
-      return "";
-    }
-  }
-  return "--" + option + " must be " + Choices(names) + ", got '" + text +
-         "'";
-}
-
-template <typename E, size_t N>
-std::string CheckEnum(const EnumName<E> (&names)[N],
-                      const std::string& option,
-                      const E value) {
-  if (NameOf(names, value) != nullptr) return "";
-  return "--" + option + " must be " + Choices(names) + ", got value " +
-         std::to_string(static_cast<int>(value));
 }
 
 ////////////////////////////////////////////////////////////////////////////////
@@ -296,9 +254,7 @@ bool RunFull(const Options& options,
              std::string* error) {
   BundleAdjustmentOptions ba_options;
   ba_options.backend = BundleAdjustmentBackend::CERES;
-  ba_options.sphere_residual = options.residual == Options::Residual::ANGULAR
-                                   ? SphereResidualType::ANGULAR
-                                   : SphereResidualType::PIXEL;
+  ba_options.sphere_residual = options.residual;
   ba_options.refine_focal_length = options.refine_intrinsics;
   ba_options.refine_extra_params = options.refine_intrinsics;
   ba_options.refine_principal_point = false;
@@ -576,40 +532,18 @@ bool RunCameraOnly(const Options& options,
 // SphereBundleAdjustmentOptions
 ////////////////////////////////////////////////////////////////////////////////
 
-const char* SphereBundleAdjustmentOptions::ModeName(const Mode mode) {
-  return NameOf(kModeNames, mode);
-}
-
-const char* SphereBundleAdjustmentOptions::ResidualName(
-    const Residual residual) {
-  return NameOf(kResidualNames, residual);
-}
-
-const char* SphereBundleAdjustmentOptions::LossName(const Loss loss) {
-  return NameOf(kLossNames, loss);
-}
-
-std::string SphereBundleAdjustmentOptions::SetFromStrings(
-    const std::string& mode_name,
-    const std::string& residual_name,
-    const std::string& loss_name) {
-  std::string error = ParseName(kModeNames, "mode", mode_name, &mode);
-  if (error.empty()) {
-    error = ParseName(kResidualNames, "residual", residual_name, &residual);
-  }
-  if (error.empty()) {
-    error = ParseName(kLossNames, "loss", loss_name, &loss);
-  }
-  return error;
-}
-
 std::string SphereBundleAdjustmentOptions::Check() const {
-  std::string error = CheckEnum(kModeNames, "mode", mode);
-  if (error.empty()) error = CheckEnum(kResidualNames, "residual", residual);
-  if (error.empty()) error = CheckEnum(kLossNames, "loss", loss);
+  std::string error =
+      CheckEnum("mode", mode, &SphereBundleAdjustmentModeToString);
+  if (error.empty()) {
+    error = CheckEnum("residual", residual, &SphereResidualTypeToString);
+  }
+  if (error.empty()) {
+    error = CheckEnum("loss", loss, &SphereBundleAdjustmentLossToString);
+  }
   if (!error.empty()) return error;
   if (residual == Residual::PIXEL && mode != Mode::FULL) {
-    return "--residual pixel is available with --mode full only (the "
+    return "--residual PIXEL is available with --mode FULL only (the "
            "camera-only BA works on rays)";
   }
   if (!(tau_px > 0) || !std::isfinite(tau_px)) {

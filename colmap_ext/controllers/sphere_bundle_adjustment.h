@@ -35,16 +35,24 @@
 #pragma once
 
 #include "colmap/scene/reconstruction.h"
+#include "colmap/util/enum_utils.h"
+#include "colmap_ext/estimators/sphere_residual_type.h"
 
 #include <map>
 #include <string>
 
 namespace colmap {
 
+MAKE_ENUM_CLASS_OVERLOAD_STREAM(SphereBundleAdjustmentMode, 0, CAMERA_ONLY,
+                                FULL);
+MAKE_ENUM_CLASS_OVERLOAD_STREAM(SphereBundleAdjustmentLoss, 0, NONE, CAUCHY);
+
+// The command line takes every enum by its name in any letter case
+// (OptionManager::AddDefaultEnumOption).
 struct SphereBundleAdjustmentOptions {
-  enum class Mode { CAMERA_ONLY, FULL };
-  enum class Residual { ANGULAR, PIXEL };
-  enum class Loss { NONE, CAUCHY };
+  using Mode = SphereBundleAdjustmentMode;
+  using Residual = SphereResidualType;
+  using Loss = SphereBundleAdjustmentLoss;
 
   Mode mode = Mode::CAMERA_ONLY;
   double tau_px = 2.0;
@@ -54,18 +62,6 @@ struct SphereBundleAdjustmentOptions {
   Loss loss = Loss::NONE;
   double loss_scale_px = 1.0;  // Cauchy scale [px]
   int min_observations_per_image = 6;
-
-  // Command-line spellings: camera_only | full, angular | pixel,
-  // none | cauchy; nullptr for a value outside the enum.
-  static const char* ModeName(Mode mode);
-  static const char* ResidualName(Residual residual);
-  static const char* LossName(Loss loss);
-
-  // Sets mode, residual and loss from their command-line spellings. Returns
-  // an empty string, or a message naming the option (e.g. "--mode ...").
-  std::string SetFromStrings(const std::string& mode,
-                             const std::string& residual,
-                             const std::string& loss);
 
   // Empty string if the options are valid, else a message naming the option.
   std::string Check() const;

@@ -20,20 +20,22 @@ int RunSphereBundleAdjuster(int argc, char** argv) {
   std::string input_path;
   std::string output_path;
   Options options;
-  std::string mode = Options::ModeName(options.mode);
-  std::string residual = Options::ResidualName(options.residual);
-  std::string loss = Options::LossName(options.loss);
-
   OptionManager option_manager;
   option_manager.AddRequiredOption("input_path", &input_path);
   option_manager.AddRequiredOption("output_path", &output_path);
-  option_manager.AddDefaultOption("mode", &mode, "camera_only or full");
+  option_manager.AddDefaultEnumOption("mode", &options.mode,
+                                      &SphereBundleAdjustmentModeToString,
+                                      &SphereBundleAdjustmentModeFromString);
   option_manager.AddDefaultOption("tau_px", &options.tau_px);
   option_manager.AddDefaultOption("max_iterations", &options.max_iterations);
   option_manager.AddDefaultOption("refine_intrinsics",
                                   &options.refine_intrinsics);
-  option_manager.AddDefaultOption("residual", &residual, "angular or pixel");
-  option_manager.AddDefaultOption("loss", &loss, "none or cauchy");
+  option_manager.AddDefaultEnumOption("residual", &options.residual,
+                                      &SphereResidualTypeToString,
+                                      &SphereResidualTypeFromString);
+  option_manager.AddDefaultEnumOption("loss", &options.loss,
+                                      &SphereBundleAdjustmentLossToString,
+                                      &SphereBundleAdjustmentLossFromString);
   option_manager.AddDefaultOption("loss_scale_px", &options.loss_scale_px);
   option_manager.AddDefaultOption("min_observations_per_image",
                                   &options.min_observations_per_image);
@@ -41,10 +43,7 @@ int RunSphereBundleAdjuster(int argc, char** argv) {
     return EXIT_FAILURE;
   }
 
-  std::string error = options.SetFromStrings(mode, residual, loss);
-  if (error.empty()) {
-    error = options.Check();
-  }
+  std::string error = options.Check();
   if (!error.empty()) {
     LOG(ERROR) << "sphere_bundle_adjuster: " << error;
     return EXIT_FAILURE;
@@ -78,8 +77,8 @@ int RunSphereBundleAdjuster(int argc, char** argv) {
   const bool camera_only = options.mode == Options::Mode::CAMERA_ONLY;
   std::ostringstream out;
   out << std::setprecision(6);
-  out << "sphere_bundle_adjuster: mode " << Options::ModeName(options.mode)
-      << ", residual " << Options::ResidualName(options.residual);
+  out << "sphere_bundle_adjuster: mode " << options.mode << ", residual "
+      << options.residual;
   if (camera_only) out << ", tau " << options.tau_px << " px";
   out << "\n  iterations:        " << summary.iterations
       << "\n  points:            " << summary.num_points_before << " -> "
