@@ -39,6 +39,10 @@ install(CODE [[
   endif()
 ]])
 
+# COLMAP sets an install RPATH of $ORIGIN/../lib for its shared-library
+# builds; with static libraries it would only point the program at whatever
+# lies there.
+set_target_properties(colmap_main sphera_render PROPERTIES INSTALL_RPATH "")
 install(TARGETS colmap_main sphera_render
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(PROGRAMS scripts/demo.sh DESTINATION ${CMAKE_INSTALL_BINDIR}

@@ -154,6 +154,13 @@ class PackageTest(TempDirTestCase):
                             "Depends %s: no linked library of it" % group)
         self.assertIn({"sqlite3"}, groups)
 
+    def test_programs_carry_no_rpath(self):
+        # Every library of the build is static: the system's libraries are
+        # found by the loader's default paths, never through an RPATH.
+        for name in ("colmap", "sphera_render"):
+            dynamic = run("objdump", "-p", self.program(name), check=True).stdout
+            self.assertNotRegex(dynamic, r"(?m)^\s*(RPATH|RUNPATH)\s", name)
+
     def test_unpacked_colmap_lists_sphera_commands(self):
         result = run(self.program("colmap"), "help", timeout=60)
         self.assertEqual(result.returncode, 0, result.stdout)
