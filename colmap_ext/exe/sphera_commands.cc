@@ -1,5 +1,6 @@
 #include "colmap_ext/exe/sphera_commands.h"
 
+#include "colmap_ext/exe/calibration_importer.h"
 #include "colmap_ext/exe/dual_fisheye_splitter.h"
 #include "colmap_ext/exe/model_evaluator.h"
 #include "colmap_ext/exe/rig_calibration.h"
@@ -11,6 +12,7 @@ namespace colmap {
 
 std::vector<std::pair<std::string, SpheraCommandFunc>> SpheraCommands() {
   return {
+      {"calibration_importer", &RunCalibrationImporter},
       {"dual_fisheye_splitter", &RunDualFisheyeSplitter},
       {"model_evaluator", &RunModelEvaluator},
       {"rig_calibration", &RunRigCalibration},
