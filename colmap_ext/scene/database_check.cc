@@ -713,7 +713,12 @@ int RemoveUnusedCameras(const std::filesystem::path& path,
   return removed;
 }
 
-std::string MissingPaths(int argc, const char* const* argv) {
+std::string MissingPaths(const std::string& command, int argc,
+                         const char* const* argv) {
+  static const std::set<std::string> kCommandsCreatingOutput = {
+      "dual_fisheye_splitter", "image_undistorter", "sphere_bundle_adjuster",
+      "sphere_undistorter"};
+  const bool creates_output = kCommandsCreatingOutput.count(command) > 0;
   std::string missing;
   for (int i = 1; i < argc; ++i) {
     std::string option = argv[i];
@@ -733,7 +738,7 @@ std::string MissingPaths(int argc, const char* const* argv) {
       continue;
     }
     // An output path in an existing folder is one the command would create.
-    if (option.size() >= 13 &&
+    if (creates_output && option.size() >= 13 &&
         option.compare(option.size() - 11, 11, "output_path") == 0 &&
         std::filesystem::is_directory(
             std::filesystem::absolute(value, error).parent_path(), error)) {

@@ -57,9 +57,13 @@ std::string NoVerifiedPairError(const std::filesystem::path& path,
                                 int min_num_inliers);
 
 // Empty, or "paths that do not exist: --OPTION PATH, ..." for the options
-// of ARGS named *_path whose value is not in the file system (said after a
-// command failed, whichever path made it fail); an *output_path in an
-// existing folder is not missing (the command would create it).
-std::string MissingPaths(int argc, const char* const* argv);
+// of ARGS named *_path whose value is not in the file system (said after
+// `colmap COMMAND ARGS` failed, whichever path made it fail). An
+// *output_path in an existing folder is not missing for the commands that
+// create their output folder (dual_fisheye_splitter, image_undistorter,
+// sphere_bundle_adjuster, sphere_undistorter); the others, such as mapper,
+// need it to exist.
+std::string MissingPaths(const std::string& command, int argc,
+                         const char* const* argv);
 
 }  // namespace colmap
