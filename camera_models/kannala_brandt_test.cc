@@ -452,8 +452,6 @@ TEST(ThinPrismFisheye, DistortionJacobianMatchesCentralDifferences) {
 TYPED_TEST(KannalaBrandtTest, AutodiffMatchesCentralDifferences) {
   using Model = TypeParam;
   constexpr int N = Model::kNumParams;
-  using RowMajor =
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   const std::vector<double> params = this->Params();
   // Away from the axis the distortion terms (1e-4 to 1e-2) need steps far
   // below the default 1e-4, as unprojection turns strongly non-linear in them
@@ -461,71 +459,13 @@ TYPED_TEST(KannalaBrandtTest, AutodiffMatchesCentralDifferences) {
   // only measure rounding.
   std::vector<double> far_steps(N, 1e-6);
   for (int i = 0; i < 4; ++i) far_steps[i] = 1e-3;
-  ceres::AutoDiffCostFunction<test::ImageFromRayFunctor<Model>, 2, 3, N>
-      project(new test::ImageFromRayFunctor<Model>);
-  ceres::AutoDiffCostFunction<test::RayFromImageFunctor<Model>, 3, 2, N>
-      unproject(new test::RayFromImageFunctor<Model>);
   for (const Eigen::Vector3d& ray :
        {RayAt(0, 0), RayAt(1e-7, 0.3), RayAt(30 * kDeg, 1.1),
         RayAt(95 * kDeg, -2.0), RayAt(100 * kDeg, 2.9)}) {
     SCOPED_TRACE(::testing::Message() << "ray " << ray.transpose());
     const std::vector<double> steps =
         ray.z() > 0.99 ? std::vector<double>() : far_steps;
-    Eigen::Vector2d pixel;
-    RowMajor d_ray(2, 3), d_params(2, N);
-    {
-      const double* blocks[2] = {ray.data(), params.data()};
-      double* jacobians[2] = {d_ray.data(), d_params.data()};
-      ASSERT_TRUE(project.Evaluate(blocks, pixel.data(), jacobians));
-    }
-    test::ExpectJacobianNear(d_ray,
-                             test::CentralDifferences(
-                                 [&](const std::vector<double>& r) {
-                                   Eigen::VectorXd p(2);
-                                   EXPECT_TRUE(Model::ImageFromRay(
-                                       params.data(), r.data(), p.data()));
-                                   return p;
-                                 },
-                                 {ray.x(), ray.y(), ray.z()}, 2),
-                             "ImageFromRay d/dray");
-    test::ExpectJacobianNear(
-        d_params,
-        test::CentralDifferences(
-            [&](const std::vector<double>& q) {
-              Eigen::VectorXd p(2);
-              EXPECT_TRUE(Model::ImageFromRay(q.data(), ray.data(), p.data()));
-              return p;
-            },
-            params, 2, steps),
-        "ImageFromRay d/dparams");
-
-    Eigen::Vector3d back;
-    RowMajor u_pixel(3, 2), u_params(3, N);
-    {
-      const double* blocks[2] = {pixel.data(), params.data()};
-      double* jacobians[2] = {u_pixel.data(), u_params.data()};
-      ASSERT_TRUE(unproject.Evaluate(blocks, back.data(), jacobians));
-    }
-    test::ExpectJacobianNear(u_pixel,
-                             test::CentralDifferences(
-                                 [&](const std::vector<double>& p) {
-                                   Eigen::VectorXd r(3);
-                                   EXPECT_TRUE(Model::RayFromImage(
-                                       params.data(), p.data(), r.data()));
-                                   return r;
-                                 },
-                                 {pixel.x(), pixel.y()}, 3),
-                             "RayFromImage d/dpixel");
-    test::ExpectJacobianNear(u_params,
-                             test::CentralDifferences(
-                                 [&](const std::vector<double>& q) {
-                                   Eigen::VectorXd r(3);
-                                   EXPECT_TRUE(Model::RayFromImage(
-                                       q.data(), pixel.data(), r.data()));
-                                   return r;
-                                 },
-                                 params, 3, steps),
-                             "RayFromImage d/dparams");
+    test::ExpectAutodiffMatchesCentralDifferences<Model>(params, ray, steps);
   }
 }
 

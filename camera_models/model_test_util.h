@@ -11,6 +11,8 @@
 #include <cmath>
 #include <vector>
 
+#include <ceres/ceres.h>
+
 namespace sphera {
 namespace test {
 
@@ -78,6 +80,78 @@ inline void ExpectJacobianNear(const Eigen::MatrixXd& autodiff,
         << autodiff << "\nnumeric\n"
         << numeric;
   }
+}
+
+// The Jacobians Ceres' autodiff gives of Model's projection at `ray` and of
+// its unprojection at the resulting pixel, with respect to the ray or pixel
+// and to the parameters, against central differences (`steps` per
+// parameter, empty for the default).
+template <typename Model>
+void ExpectAutodiffMatchesCentralDifferences(const std::vector<double>& params,
+                                             const Eigen::Vector3d& ray,
+                                             const std::vector<double>& steps) {
+  constexpr int N = Model::kNumParams;
+  using RowMajor =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  ceres::AutoDiffCostFunction<ImageFromRayFunctor<Model>, 2, 3, N> project(
+      new ImageFromRayFunctor<Model>);
+  ceres::AutoDiffCostFunction<RayFromImageFunctor<Model>, 3, 2, N> unproject(
+      new RayFromImageFunctor<Model>);
+  Eigen::Vector2d pixel;
+  RowMajor d_ray(2, 3), d_params(2, N);
+  {
+    const double* blocks[2] = {ray.data(), params.data()};
+    double* jacobians[2] = {d_ray.data(), d_params.data()};
+    ASSERT_TRUE(project.Evaluate(blocks, pixel.data(), jacobians));
+  }
+  ExpectJacobianNear(d_ray,
+                           CentralDifferences(
+                               [&](const std::vector<double>& r) {
+                                 Eigen::VectorXd p(2);
+                                 EXPECT_TRUE(Model::ImageFromRay(
+                                     params.data(), r.data(), p.data()));
+                                 return p;
+                               },
+                               {ray.x(), ray.y(), ray.z()}, 2),
+                           "ImageFromRay d/dray");
+  ExpectJacobianNear(
+      d_params,
+      CentralDifferences(
+          [&](const std::vector<double>& q) {
+            Eigen::VectorXd p(2);
+            EXPECT_TRUE(Model::ImageFromRay(q.data(), ray.data(), p.data()));
+            return p;
+          },
+          params, 2, steps),
+      "ImageFromRay d/dparams");
+
+  Eigen::Vector3d back;
+  RowMajor u_pixel(3, 2), u_params(3, N);
+  {
+    const double* blocks[2] = {pixel.data(), params.data()};
+    double* jacobians[2] = {u_pixel.data(), u_params.data()};
+    ASSERT_TRUE(unproject.Evaluate(blocks, back.data(), jacobians));
+  }
+  ExpectJacobianNear(u_pixel,
+                           CentralDifferences(
+                               [&](const std::vector<double>& p) {
+                                 Eigen::VectorXd r(3);
+                                 EXPECT_TRUE(Model::RayFromImage(
+                                     params.data(), p.data(), r.data()));
+                                 return r;
+                               },
+                               {pixel.x(), pixel.y()}, 3),
+                           "RayFromImage d/dpixel");
+  ExpectJacobianNear(u_params,
+                           CentralDifferences(
+                               [&](const std::vector<double>& q) {
+                                 Eigen::VectorXd r(3);
+                                 EXPECT_TRUE(Model::RayFromImage(
+                                     q.data(), pixel.data(), r.data()));
+                                 return r;
+                               },
+                               params, 3, steps),
+                           "RayFromImage d/dparams");
 }
 
 }  // namespace test

@@ -273,13 +273,6 @@ TEST(OCam, CheckParams) {
 }
 
 TEST(OCam, AutodiffMatchesCentralDifferences) {
-  constexpr int N = OCamModel::kNumParams;
-  using RowMajor =
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  ceres::AutoDiffCostFunction<test::ImageFromRayFunctor<OCamModel>, 2, 3, N>
-      project(new test::ImageFromRayFunctor<OCamModel>);
-  ceres::AutoDiffCostFunction<test::RayFromImageFunctor<OCamModel>, 3, 2, N>
-      unproject(new test::RayFromImageFunctor<OCamModel>);
   // Away from the axis coefficients from 1 to 1e-9 need steps of their own
   // scale; near it they hardly matter and a small step would only measure
   // rounding.
@@ -299,61 +292,8 @@ TEST(OCam, AutodiffMatchesCentralDifferences) {
     const Eigen::Vector3d& ray = c.ray;
     const std::vector<double> steps =
         ray.z() > 0.99 ? std::vector<double>() : far_steps;
-    Eigen::Vector2d pixel;
-    RowMajor d_ray(2, 3), d_params(2, N);
-    {
-      const double* blocks[2] = {ray.data(), params.data()};
-      double* jacobians[2] = {d_ray.data(), d_params.data()};
-      ASSERT_TRUE(project.Evaluate(blocks, pixel.data(), jacobians));
-    }
-    test::ExpectJacobianNear(d_ray,
-                             test::CentralDifferences(
-                                 [&](const std::vector<double>& r) {
-                                   Eigen::VectorXd p(2);
-                                   EXPECT_TRUE(OCamModel::ImageFromRay(
-                                       params.data(), r.data(), p.data()));
-                                   return p;
-                                 },
-                                 {ray.x(), ray.y(), ray.z()}, 2),
-                             "ImageFromRay d/dray");
-    test::ExpectJacobianNear(d_params,
-                             test::CentralDifferences(
-                                 [&](const std::vector<double>& q) {
-                                   Eigen::VectorXd p(2);
-                                   EXPECT_TRUE(OCamModel::ImageFromRay(
-                                       q.data(), ray.data(), p.data()));
-                                   return p;
-                                 },
-                                 params, 2, steps),
-                             "ImageFromRay d/dparams");
-
-    Eigen::Vector3d back;
-    RowMajor u_pixel(3, 2), u_params(3, N);
-    {
-      const double* blocks[2] = {pixel.data(), params.data()};
-      double* jacobians[2] = {u_pixel.data(), u_params.data()};
-      ASSERT_TRUE(unproject.Evaluate(blocks, back.data(), jacobians));
-    }
-    test::ExpectJacobianNear(u_pixel,
-                             test::CentralDifferences(
-                                 [&](const std::vector<double>& p) {
-                                   Eigen::VectorXd r(3);
-                                   EXPECT_TRUE(OCamModel::RayFromImage(
-                                       params.data(), p.data(), r.data()));
-                                   return r;
-                                 },
-                                 {pixel.x(), pixel.y()}, 3),
-                             "RayFromImage d/dpixel");
-    test::ExpectJacobianNear(u_params,
-                             test::CentralDifferences(
-                                 [&](const std::vector<double>& q) {
-                                   Eigen::VectorXd r(3);
-                                   EXPECT_TRUE(OCamModel::RayFromImage(
-                                       q.data(), pixel.data(), r.data()));
-                                   return r;
-                                 },
-                                 params, 3, steps),
-                             "RayFromImage d/dparams");
+    test::ExpectAutodiffMatchesCentralDifferences<OCamModel>(params, ray,
+                                                             steps);
   }
 }
 
