@@ -22,24 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool HasImageExtension(const std::string& name) {
-  std::string lower = name;
-  std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
-  for (const char* ext : {".jpg", ".jpeg", ".png"}) {
-    const std::string e(ext);
-    if (lower.size() > e.size() && lower.compare(lower.size() - e.size(), e.size(), e) == 0) {
-      return true;
-    }
-  }
-  return false;
-}
-
-bool IsPng(const std::string& name) {
-  std::string lower = name;
-  std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
-  return lower.size() > 4 && lower.compare(lower.size() - 4, 4, ".png") == 0;
-}
-
 // Rotation about world axis `axis` by `angle` radians.
 Eigen::Matrix3d AxisRotation(int axis, double angle) {
   return Eigen::AngleAxisd(angle, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
@@ -220,7 +202,7 @@ std::string ReadRigFile(const std::string& path, const std::string& default_exte
     if (!(head >> name >> model >> width_text >> height_text)) {
       return where + "expected NAME MODEL WIDTH HEIGHT before '|'";
     }
-    if (!HasImageExtension(name)) name += default_extension;
+    if (!IsJpegFileName(name) && !IsPngFileName(name)) name += default_extension;
     const std::string camera = where + "camera '" + name + "': ";
     int width = 0, height = 0;
     try {
@@ -645,11 +627,6 @@ std::string WriteModel(const fs::path& tmp, const std::vector<VirtualCamera>& ca
 }
 
 }  // namespace
-
-std::vector<int> ImageWriteParams(const std::string& name, int jpeg_quality) {
-  if (IsPng(name)) return {cv::IMWRITE_PNG_COMPRESSION, 3};
-  return {cv::IMWRITE_JPEG_QUALITY, jpeg_quality > 0 ? jpeg_quality : 95};
-}
 
 std::string WriteDataset(const std::string& output_dir, const Scene& scene,
                          const std::vector<VirtualCamera>& cameras,

@@ -30,6 +30,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "synthetic/file_formats.h"
 #include "synthetic/render.h"
 #include "synthetic/scene.h"
 #include "synthetic/sensor_effects.h"
@@ -127,9 +128,6 @@ struct DatasetOptions {
   std::function<std::string(const std::string& staging_dir, std::ostream* log)> extra;
 };
 
-// cv::imwrite parameters for an image named `name`: PNG (compression 3) or
-// JPEG at `jpeg_quality` (0: 95).
-std::vector<int> ImageWriteParams(const std::string& name, int jpeg_quality);
 
 // Renders every camera and writes the dataset into `output_dir` atomically
 // (via output_dir + ".tmp"). Refuses an existing non-empty `output_dir`.

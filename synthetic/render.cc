@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "camera_models/registry.h"
+#include "synthetic/file_formats.h"
 
 namespace sphera {
 namespace synthetic {
@@ -284,30 +285,21 @@ cv::Mat ToEightBit(const cv::Mat& radiance) {
 
 bool WriteDepthMap(const std::string& path, const cv::Mat& depth) {
   if (depth.type() != CV_32F) return false;
-  std::ofstream file(path, std::ios::binary);
-  if (!file) return false;
-  const int32_t size[2] = {depth.cols, depth.rows};
-  file.write(reinterpret_cast<const char*>(size), sizeof(size));
+  RangeMap map;
+  map.width = depth.cols;
+  map.height = depth.rows;
+  map.ranges.reserve(static_cast<size_t>(depth.total()));
   for (int row = 0; row < depth.rows; ++row) {
-    file.write(reinterpret_cast<const char*>(depth.ptr<float>(row)),
-               static_cast<std::streamsize>(sizeof(float)) * depth.cols);
+    map.ranges.insert(map.ranges.end(), depth.ptr<float>(row), depth.ptr<float>(row) + depth.cols);
   }
-  return static_cast<bool>(file);
+  return WriteRangeMap(path, map);
 }
 
 bool ReadDepthMap(const std::string& path, cv::Mat* depth) {
-  std::ifstream file(path, std::ios::binary);
-  int32_t size[2];
-  if (!file.read(reinterpret_cast<char*>(size), sizeof(size))) return false;
-  if (size[0] <= 0 || size[1] <= 0 || size[0] > 65536 || size[1] > 65536) return false;
-  depth->create(size[1], size[0], CV_32F);
-  for (int row = 0; row < size[1]; ++row) {
-    if (!file.read(reinterpret_cast<char*>(depth->ptr<float>(row)),
-                   static_cast<std::streamsize>(sizeof(float)) * size[0])) {
-      return false;
-    }
-  }
-  return file.peek() == std::ifstream::traits_type::eof();
+  RangeMap map;
+  if (!ReadRangeMap(path, &map).empty()) return false;
+  cv::Mat(map.height, map.width, CV_32F, map.ranges.data()).copyTo(*depth);
+  return true;
 }
 
 }  // namespace synthetic

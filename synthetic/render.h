@@ -100,8 +100,8 @@ RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
 // and clamped to [0, 255].
 cv::Mat ToEightBit(const cv::Mat& radiance);
 
-// Depth file: int32 width, int32 height, then width*height float32 ranges in
-// metres, row-major (row 0 first), all little-endian; 0 where nothing is hit.
+// A rendered range map as a CV_32F image, in the range-map file format
+// (synthetic/file_formats.h); false where the file cannot be written or read.
 bool WriteDepthMap(const std::string& path, const cv::Mat& depth);
 bool ReadDepthMap(const std::string& path, cv::Mat* depth);
 

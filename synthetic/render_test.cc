@@ -1,13 +1,17 @@
 #include "synthetic/render.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "camera_models/registry.h"
+#include "synthetic/file_formats.h"
 
 namespace sphera {
 namespace synthetic {
@@ -317,6 +321,56 @@ TEST(Render, DepthFileRoundTrip) {
   EXPECT_EQ(header[0], 5);
   EXPECT_EQ(header[1], 3);
   std::remove(path.c_str());
+}
+
+// Every way a range-map file can be damaged is refused with its reason.
+TEST(Render, DamagedRangeMapsAreRefused) {
+  const std::string path = ::testing::TempDir() + "/sphera_damaged_range.bin";
+  const auto refusal = [&](const RangeMap& map, size_t keep_bytes, const std::string& extra) {
+    EXPECT_TRUE(WriteRangeMap(path, map));
+    std::string bytes;
+    {
+      std::ifstream in(path, std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    bytes = bytes.substr(0, std::min(keep_bytes, bytes.size())) + extra;
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    RangeMap read;
+    return ReadRangeMap(path, &read);
+  };
+  RangeMap map;
+  map.width = 2;
+  map.height = 2;
+  map.ranges = {1.0f, 0.0f, 2.5f, 3.0f};
+  EXPECT_EQ(refusal(map, 1000, ""), "");
+  EXPECT_NE(refusal(map, 4, "").find("header"), std::string::npos);
+  EXPECT_NE(refusal(map, 20, "").find("fewer than its 4 ranges"), std::string::npos);
+  EXPECT_NE(refusal(map, 1000, "x").find("more bytes"), std::string::npos);
+  RangeMap nan = map;
+  nan.ranges[3] = std::nanf("");
+  EXPECT_NE(refusal(nan, 1000, "").find("at pixel (1, 1)"), std::string::npos);
+  RangeMap negative = map;
+  negative.ranges[1] = -1.0f;
+  EXPECT_NE(refusal(negative, 1000, "").find("at pixel (1, 0)"), std::string::npos);
+  RangeMap huge = map;
+  huge.width = 70000;
+  EXPECT_NE(refusal(huge, 1000, "").find("size 70000x2"), std::string::npos);
+  RangeMap missing;
+  EXPECT_EQ(ReadRangeMap(path + ".absent", &missing), "cannot be read");
+  std::remove(path.c_str());
+}
+
+// Image files are told apart by their names in any letter case.
+TEST(Render, ImageFileNames) {
+  EXPECT_TRUE(IsJpegFileName("a/B.JPG"));
+  EXPECT_TRUE(IsJpegFileName("frame.insp"));
+  EXPECT_FALSE(IsJpegFileName("x.jpg/png"));
+  EXPECT_TRUE(IsPngFileName("mask.Png"));
+  EXPECT_TRUE(IsImageFileName("raw.TIFF"));
+  EXPECT_FALSE(IsImageFileName("notes.txt"));
+  EXPECT_FALSE(IsImageFileName("dir.jpg/file"));
+  EXPECT_EQ(ImageWriteParams("x.bmp", 80), std::vector<int>{});
+  EXPECT_EQ(ImageWriteParams("x.png", 80), (std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 3}));
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 #include "colmap/sensor/models.h"
 #include "colmap/util/logging.h"
 #include "colmap_ext/image/dual_fisheye_split.h"
+#include "colmap_ext/util/file_output.h"
+#include "synthetic/file_formats.h"
 
 #include <algorithm>
 #include <array>
@@ -30,39 +32,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// File name extensions (lower case) of the raw frames looked for in
-// --input_path; other files are left alone. Insta360's .insp stills are
-// JPEG files.
-const std::set<std::string>& RawFrameExtensions() {
-  static const std::set<std::string> extensions = {".jpg",
-                                                   ".jpeg",
-                                                   ".png",
-                                                   ".tif",
-                                                   ".tiff",
-                                                   ".bmp",
-                                                   ".pgm",
-                                                   ".ppm",
-                                                   ".pnm",
-                                                   ".webp",
-                                                   ".insp"};
-  return extensions;
-}
-
-std::string LowerCaseExtension(const fs::path& path) {
-  std::string extension = path.extension().string();
-  std::transform(
-      extension.begin(), extension.end(), extension.begin(), [](char c) {
-        return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-      });
-  return extension;
-}
-
-// The extension that tells OpenCV's encoder the format of a lens image
-// written under the name of its raw frame (the input's format).
-std::string EncoderExtension(const fs::path& name) {
-  const std::string extension = LowerCaseExtension(name);
-  return extension == ".insp" ? ".jpg" : extension;
-}
+using sphera::EncoderExtension;
+using sphera::ImageFileExtensions;
+using sphera::IsImageFileName;
+using sphera::LowerCaseExtension;
 
 std::vector<std::string> SplitText(const std::string& text, char separator) {
   std::vector<std::string> parts;
@@ -207,78 +180,6 @@ void ThrowIfAny(const std::string& headline,
   throw std::invalid_argument(message);
 }
 
-// Files written under temporary names beside their final ones, renamed when
-// all are written; anything left half-done (files, folders this made) is
-// removed when it is destroyed before Commit().
-class StagedOutput {
- public:
-  ~StagedOutput() {
-    if (committed_) {
-      return;
-    }
-    std::error_code ignored;
-    for (const auto& [temporary, final_path] : files_) {
-      fs::remove(temporary, ignored);
-    }
-    for (const fs::path& path : renamed_) {
-      fs::remove(path, ignored);
-    }
-    for (auto folder = created_folders_.rbegin();
-         folder != created_folders_.rend();
-         ++folder) {
-      fs::remove(*folder, ignored);  // only if empty
-    }
-  }
-
-  void Write(const fs::path& path, const std::string& bytes) {
-    CreateFolders(path.parent_path());
-    const fs::path temporary =
-        path.string() + ".tmp-" + std::to_string(::getpid());
-    files_.emplace_back(temporary, path);
-    std::ofstream file(temporary, std::ios::binary);
-    file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    file.close();
-    if (!file) {
-      throw std::runtime_error("cannot write " + temporary.string() +
-                               " (disk full? no permission?)");
-    }
-  }
-
-  void Commit() {
-    for (const auto& [temporary, final_path] : files_) {
-      std::error_code error;
-      fs::rename(temporary, final_path, error);
-      if (error) {
-        throw std::runtime_error("cannot rename " + temporary.string() +
-                                 " to " + final_path.string() + ": " +
-                                 error.message());
-      }
-      renamed_.push_back(final_path);
-    }
-    committed_ = true;
-  }
-
- private:
-  void CreateFolders(const fs::path& folder) {
-    if (folder.empty() || fs::is_directory(folder)) {
-      return;
-    }
-    CreateFolders(folder.parent_path());
-    std::error_code error;
-    fs::create_directory(folder, error);
-    if (error) {
-      throw std::runtime_error("cannot create the folder " + folder.string() +
-                               ": " + error.message());
-    }
-    created_folders_.push_back(folder);
-  }
-
-  std::vector<std::pair<fs::path, fs::path>> files_;  // temporary, final
-  std::vector<fs::path> renamed_;
-  std::vector<fs::path> created_folders_;
-  bool committed_ = false;
-};
-
 std::string EncodeImage(const cv::Mat& image,
                         const std::string& extension,
                         const std::vector<int>& params,
@@ -310,14 +211,14 @@ struct FrameFiles {
 };
 
 // Names (relative to FOLDER, '/'-separated, sorted) of the image files
-// below FOLDER (RawFrameExtensions(); none below EXCLUDED).
+// below FOLDER (ImageFileExtensions(); none below EXCLUDED).
 std::vector<std::string> ListImageFiles(const fs::path& folder,
                                         const fs::path& excluded) {
   std::vector<std::string> names;
   for (const fs::directory_entry& entry :
        fs::recursive_directory_iterator(folder)) {
     if (!entry.is_regular_file() ||
-        RawFrameExtensions().count(LowerCaseExtension(entry.path())) == 0 ||
+        !IsImageFileName(entry.path().string()) ||
         IsWithin(entry.path(), excluded)) {
       continue;
     }
@@ -551,7 +452,7 @@ std::vector<FrameFiles> ListFrames(const DualFisheyeSplittingOptions& options) {
   }
   if (frames.empty()) {
     std::string extensions;
-    for (const std::string& extension : RawFrameExtensions()) {
+    for (const std::string& extension : ImageFileExtensions()) {
       extensions += (extensions.empty() ? "" : " ") + extension;
     }
     const std::string where =
@@ -857,10 +758,8 @@ void WriteOutputs(const DualFisheyeSplittingOptions& options,
   for (const FrameFiles& frame : frames) {
     const std::array<cv::Mat, 2> lenses = ReadLensImages(frame);
     const std::string extension = EncoderExtension(frame.name);
-    std::vector<int> params;
-    if (extension == ".jpg" || extension == ".jpeg") {
-      params = {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality};
-    }
+    const std::vector<int> params =
+        sphera::ImageWriteParams(extension, options.jpeg_quality);
     for (int lens = 0; lens < 2; ++lens) {
       if (lenses[lens].empty()) {
         continue;

@@ -8,6 +8,7 @@
 #include "colmap/util/string.h"
 #include "colmap_ext/controllers/sphere_bundle_adjustment.h"
 #include "estimators/similarity_alignment.h"
+#include "synthetic/file_formats.h"
 
 #include <algorithm>
 #include <cmath>
@@ -23,47 +24,27 @@
 namespace colmap {
 namespace {
 
-// sphera_render's range map: int32 width, int32 height, then row-major
-// float32 ranges along the pixel-centre rays (little-endian); 0 = no hit.
+using sphera::RangeMap;
+using sphera::ReadRangeMap;
+
+// sphera_render's range map of one image (synthetic/file_formats.h).
 struct DepthMap {
-  int width = 0;
-  int height = 0;
-  std::vector<float> ranges;
+  RangeMap map;
 
   // Empty, or why the file at `path` is not the range map of an image of
-  // `camera`'s size: unreadable, another size, short, or a range that is
-  // negative or not finite (a damaged file would bias every point error).
+  // `camera`'s size: unreadable, damaged, another size, or holding a range
+  // that is negative or not finite (a damaged file would bias every point
+  // error).
   std::string Read(const std::string& path, const Camera& camera) {
-    std::ifstream file(path, std::ios::binary);
-    if (!file) {
-      return "cannot be read";
+    if (std::string error = ReadRangeMap(path, &map); !error.empty()) {
+      return error;
     }
-    int32_t size[2];
-    file.read(reinterpret_cast<char*>(size), sizeof(size));
-    if (!file) {
-      return "is shorter than its 8-byte header";
-    }
-    if (size[0] != static_cast<int64_t>(camera.width) ||
-        size[1] != static_cast<int64_t>(camera.height)) {
-      return "is " + std::to_string(size[0]) + "x" + std::to_string(size[1]) +
-             ", its image " + std::to_string(camera.width) + "x" +
+    if (map.width != static_cast<int64_t>(camera.width) ||
+        map.height != static_cast<int64_t>(camera.height)) {
+      return "is " + std::to_string(map.width) + "x" +
+             std::to_string(map.height) + ", its image " +
+             std::to_string(camera.width) + "x" +
              std::to_string(camera.height);
-    }
-    width = size[0];
-    height = size[1];
-    ranges.resize(static_cast<size_t>(width) * height);
-    file.read(reinterpret_cast<char*>(ranges.data()),
-              ranges.size() * sizeof(float));
-    if (!file) {
-      return "holds fewer than its " + std::to_string(ranges.size()) +
-             " ranges";
-    }
-    for (size_t i = 0; i < ranges.size(); ++i) {
-      if (!std::isfinite(ranges[i]) || ranges[i] < 0) {
-        return "has the range " + std::to_string(ranges[i]) + " at pixel (" +
-               std::to_string(i % width) + ", " + std::to_string(i / width) +
-               ")";
-      }
     }
     return "";
   }
@@ -76,7 +57,7 @@ struct DepthMap {
   double At(const Eigen::Vector2d& point2D) const {
     const int x = static_cast<int>(std::floor(point2D.x()));
     const int y = static_cast<int>(std::floor(point2D.y()));
-    if (x < 0 || y < 0 || x >= width || y >= height) {
+    if (x < 0 || y < 0 || x >= map.width || y >= map.height) {
       return 0;
     }
     const double nearest = Range(x, y);
@@ -84,7 +65,7 @@ struct DepthMap {
     const double v = point2D.y() - 0.5;
     const int x0 = static_cast<int>(std::floor(u));
     const int y0 = static_cast<int>(std::floor(v));
-    if (x0 < 0 || y0 < 0 || x0 + 1 >= width || y0 + 1 >= height) {
+    if (x0 < 0 || y0 < 0 || x0 + 1 >= map.width || y0 + 1 >= map.height) {
       return nearest;
     }
     const double r00 = Range(x0, y0);
@@ -102,9 +83,7 @@ struct DepthMap {
   }
 
  private:
-  double Range(int x, int y) const {
-    return ranges[static_cast<size_t>(y) * width + x];
-  }
+  double Range(int x, int y) const { return map.At(x, y); }
 };
 
 double ClosestPairBaseline(const Reconstruction& reconstruction) {

@@ -9,6 +9,8 @@
 #include "colmap/sensor/models.h"
 #include "colmap/util/logging.h"
 #include "colmap/util/timer.h"
+#include "colmap_ext/util/file_output.h"
+#include "synthetic/file_formats.h"
 #include "colmap/util/types.h"
 
 #include <algorithm>
@@ -170,24 +172,6 @@ std::vector<View> PlanViews(const Image& image,
   return views;
 }
 
-// Removes a folder tree when it goes out of scope, unless released.
-class ScopedRemover {
- public:
-  explicit ScopedRemover(fs::path path) : path_(std::move(path)) {}
-  ScopedRemover(const ScopedRemover&) = delete;
-  ScopedRemover& operator=(const ScopedRemover&) = delete;
-  ~ScopedRemover() {
-    if (!path_.empty()) {
-      std::error_code error;
-      fs::remove_all(path_, error);
-    }
-  }
-  void Release() { path_.clear(); }
-
- private:
-  fs::path path_;
-};
-
 // Empty when `output` can receive a workspace: it does not exist, or is a
 // folder whose images/, sparse/ and stereo/ are absent or empty.
 std::string OutputConflict(const fs::path& output) {
@@ -227,45 +211,13 @@ void CreateFolders(const fs::path& root, const std::string& name) {
   fs::create_directories(parent);
 }
 
-// Moves the finished temporary workspace into `output`.
-void MoveIntoPlace(const fs::path& temp, const fs::path& output) {
-  std::error_code error;
-  if (!fs::exists(output, error)) {
-    fs::rename(temp, output);
-    return;
-  }
-  std::vector<fs::path> moved;
-  try {
-    for (const auto& entry : fs::directory_iterator(temp)) {
-      const fs::path target = output / entry.path().filename();
-      if (fs::exists(target)) {
-        // Only empty folders get here (OutputConflict checked it).
-        if (!fs::is_directory(target) || !fs::is_empty(target)) {
-          throw std::invalid_argument("output_path: " + target.string() +
-                                      " appeared while exporting");
-        }
-        fs::remove(target);
-      }
-      fs::rename(entry.path(), target);
-      moved.push_back(target);
-    }
-  } catch (...) {
-    for (const fs::path& path : moved) {
-      fs::remove_all(path, error);
-    }
-    throw;
-  }
-  fs::remove_all(temp, error);
-}
-
 void WriteImage(const std::string& path,
                 const cv::Mat& image,
                 const SphereUndistorterOptions& options) {
   std::vector<int> params;
-  const std::string ext = fs::path(path).extension().string();
   cv::Mat output = image;
-  if (ext == ".jpg" || ext == ".jpeg" || ext == ".JPG" || ext == ".JPEG") {
-    params = {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality};
+  if (sphera::IsJpegFileName(path)) {
+    params = sphera::ImageWriteParams(path, options.jpeg_quality);
     if (image.channels() == 4) {
       cv::cvtColor(image, output, cv::COLOR_BGRA2BGR);
     }
@@ -715,15 +667,8 @@ SphereExportSummary ExportPerspectiveWorkspace(
   }
 
   // Temporary workspace beside the output, moved into place at the end.
-  const std::string temp_template = output.string() + ".tmp-XXXXXX";
-  std::vector<char> temp_buffer(temp_template.begin(), temp_template.end());
-  temp_buffer.push_back('\0');
-  if (mkdtemp(temp_buffer.data()) == nullptr) {
-    throw std::runtime_error("cannot create a temporary folder beside " +
-                             output.string());
-  }
-  const fs::path temp(temp_buffer.data());
-  ScopedRemover remover(temp);
+  StagedOutput staged;
+  const fs::path temp = staged.StageFolder(output);
   const fs::path images_dir = temp / "images";
   const fs::path sparse_dir =
       options.splatting ? temp / "sparse" / "0" : temp / "sparse";
@@ -953,8 +898,7 @@ SphereExportSummary ExportPerspectiveWorkspace(
   if (!late_conflict.empty()) {
     throw std::invalid_argument(late_conflict);
   }
-  MoveIntoPlace(temp, output);
-  remover.Release();
+  staged.Commit();
   summary.seconds = timer.ElapsedSeconds();
   return summary;
 }
