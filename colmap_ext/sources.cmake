@@ -23,6 +23,7 @@ set(SPHERA_COLMAP_SCENE_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/scene/database_check.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/intrinsics_divergence.cc)
 set(SPHERA_COLMAP_CONTROLLER_LIBS
+  $<BUILD_INTERFACE:sphera_calibration>
   $<BUILD_INTERFACE:sphera_estimators>
   $<BUILD_INTERFACE:opencv_core>
   $<BUILD_INTERFACE:opencv_imgproc>

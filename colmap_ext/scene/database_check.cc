@@ -716,8 +716,8 @@ int RemoveUnusedCameras(const std::filesystem::path& path,
 std::string MissingPaths(const std::string& command, int argc,
                          const char* const* argv) {
   static const std::set<std::string> kCommandsCreatingOutput = {
-      "dual_fisheye_splitter", "image_undistorter", "sphere_bundle_adjuster",
-      "sphere_undistorter"};
+      "dual_fisheye_splitter", "image_undistorter", "rig_preset",
+      "sphere_bundle_adjuster", "sphere_undistorter"};
   const bool creates_output = kCommandsCreatingOutput.count(command) > 0;
   std::string missing;
   for (int i = 1; i < argc; ++i) {

@@ -60,8 +60,9 @@ std::string NoVerifiedPairError(const std::filesystem::path& path,
 // of ARGS named *_path whose value is not in the file system (said after
 // `colmap COMMAND ARGS` failed, whichever path made it fail). An
 // *output_path in an existing folder is not missing for the commands that
-// create their output folder (dual_fisheye_splitter, image_undistorter,
-// sphere_bundle_adjuster, sphere_undistorter); the others, such as mapper,
+// create their output (dual_fisheye_splitter, image_undistorter,
+// rig_preset, sphere_bundle_adjuster, sphere_undistorter); the others, such
+// as mapper,
 // need it to exist.
 std::string MissingPaths(const std::string& command, int argc,
                          const char* const* argv);
