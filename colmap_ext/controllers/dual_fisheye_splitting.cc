@@ -1,5 +1,6 @@
 #include "colmap_ext/controllers/dual_fisheye_splitting.h"
 
+#include "calibration/camera_presets.h"
 #include "colmap/sensor/models.h"
 #include "colmap/util/logging.h"
 #include "colmap_ext/image/dual_fisheye_split.h"
@@ -745,7 +746,7 @@ void WriteOutputs(const DualFisheyeSplittingOptions& options,
                   const std::array<std::string, 2>& lens_names,
                   const std::array<ImageCircle, 2>& circles,
                   const cv::Size& lens_size,
-                  const std::string& camera_json) {
+                  const std::string& rig_config) {
   const fs::path& out = options.output_path;
   StagedOutput staged;
   std::array<std::string, 2> mask_bytes;  // the same for every frame
@@ -774,9 +775,46 @@ void WriteOutputs(const DualFisheyeSplittingOptions& options,
                    mask_bytes[lens]);
     }
   }
-  staged.Write(out / "rig_config.json", RigConfigJson(lens_names, camera_json));
+  staged.Write(out / "rig_config.json", rig_config);
   staged.Write(out / "circles.txt", CirclesText(lens_names, circles));
   staged.Commit();
+}
+
+// The preset's image circles for the frames' lens images (of the first
+// readable frame; ScanFrames refuses frames of another size), and its
+// resolution; nothing when no frame can be read (ScanFrames names them);
+// throws naming the frame when the preset knows no such size.
+std::optional<std::pair<std::array<ImageCircle, 2>, sphera::PresetResolution>>
+PresetCircles(const sphera::CameraPreset& preset,
+              const std::vector<FrameFiles>& frames) {
+  for (const FrameFiles& frame : frames) {
+    std::array<cv::Mat, 2> lenses;
+    try {
+      lenses = ReadLensImages(frame);
+    } catch (const std::exception&) {
+      continue;  // ScanFrames names it
+    }
+    const cv::Size size = (lenses[0].empty() ? lenses[1] : lenses[0]).size();
+    // The size of the file the preset stores: both lenses side by side, or
+    // one lens.
+    const int lenses_per_file =
+        preset.storage == sphera::LensStorage::kSideBySide ? 2 : 1;
+    sphera::PresetResolution resolution;
+    try {
+      resolution = sphera::FindPresetResolution(
+          preset, lenses_per_file * size.width, size.height);
+    } catch (const std::invalid_argument& error) {
+      throw std::invalid_argument(frame.name + ": lens images " +
+                                  SizeText(size) + ": " + error.what());
+    }
+    std::array<ImageCircle, 2> circles;
+    for (int lens = 0; lens < 2; ++lens) {
+      const sphera::PresetCircle& circle = resolution.circles.at(lens);
+      circles[lens] = {circle.cx, circle.cy, circle.r};
+    }
+    return std::make_pair(circles, resolution);
+  }
+  return std::nullopt;
 }
 
 // How far the farthest of CIRCLES is from MEDIAN (centre distance plus
@@ -846,6 +884,25 @@ void DualFisheyeSplittingOptions::Check() const {
   }
   ParseLensNames(lens_names);
   CameraJson(camera_model, camera_params);
+  if (!camera.empty()) {
+    const sphera::CameraPreset& preset = sphera::FindCameraPreset(camera);
+    if (!circles.empty() || !camera_model.empty()) {
+      throw std::invalid_argument(
+          "--camera " + camera +
+          " gives the circles and the lens model; not with --circles, "
+          "--camera_model or --camera_params");
+    }
+    if (preset.storage == sphera::LensStorage::kFilePerLens ||
+        preset.storage == sphera::LensStorage::kEquirectangular ||
+        preset.lenses.size() != 2) {
+      throw std::invalid_argument(
+          "--camera " + preset.name + ": " + std::to_string(
+              preset.lenses.size()) + " lens(es), " +
+          sphera::LensStorageName(preset.storage) +
+          ": nothing to split (colmap rig_preset --camera " + preset.name +
+          " writes its rig config)");
+    }
+  }
   if (!circles.empty()) {
     std::array<ImageCircle, 2> parsed;
     if (const std::string error = ParseImageCircles(circles, &parsed);
@@ -870,6 +927,24 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
 
   const std::vector<FrameFiles> frames = ListFrames(options);
   CheckOutputsAreNew(frames, lens_names, options.output_path);
+  std::string rig_config;
+  if (!options.camera.empty()) {
+    const sphera::CameraPreset& preset =
+        sphera::FindCameraPreset(options.camera);
+    const auto found = PresetCircles(preset, frames);
+    if (!found) {
+      ScanFrames(frames, lens_names, given_circles, options.black_level);
+      throw std::invalid_argument("no frame can be read");
+    }
+    const auto& [circles, resolution] = *found;
+    given_circles = circles;
+    rig_config = sphera::PresetRigConfigJson(
+        preset, resolution, {lens_names[0], lens_names[1]});
+    LOG(INFO) << "dual_fisheye_splitter: " << preset.name << " "
+              << resolution.name << ": circles " << resolution.source;
+  } else {
+    rig_config = RigConfigJson(lens_names, camera_json);
+  }
   const FrameScan scan =
       ScanFrames(frames, lens_names, given_circles, options.black_level);
   std::array<ImageCircle, 2> circles;
@@ -883,7 +958,7 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
   for (int lens = 0; lens < 2; ++lens) {
     std::ostringstream origin;
     if (given_circles) {
-      origin << "given";
+      origin << (options.camera.empty() ? "given" : "of the preset");
     } else {
       origin << "detected (median of " << scan.detected[lens].size() << " of "
              << frames.size() << " frames, each within "
@@ -909,7 +984,7 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
   }
 
   WriteOutputs(
-      options, frames, lens_names, circles, scan.lens_size, camera_json);
+      options, frames, lens_names, circles, scan.lens_size, rig_config);
   size_t num_images = 0;
   for (const FrameFiles& frame : frames) {
     num_images += frame.SideBySide() ? 2

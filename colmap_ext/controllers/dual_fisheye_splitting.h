@@ -24,10 +24,12 @@
 //                               outside the circle black; NAME's format
 //   OUT/masks/<lens>/NAME.png   255 inside the image circle, 0 outside
 //   OUT/rig_config.json         lens1 = lens0 turned 180 degrees about y
+//                               (with `camera`, the preset's config)
 //   OUT/circles.txt             "<lens> cx cy r", one line per lens, after
 //                               a '#' comment line (as the renderer's)
-// The image circles are `circles`, or detected in every frame
-// (DetectImageCircle) and the median taken per lens. All frames are read
+// The image circles are `circles`, those of the camera preset `camera`
+// (calibration/camera_presets.h) at the frames' size, or detected in every
+// frame (DetectImageCircle) and the median taken per lens. All frames are read
 // and checked (readable, one size, DualFisheyeFrameError, each frame's two
 // lens files, no existing output) before anything is written; every file is
 // written under a temporary name and renamed when all are written, so a
@@ -55,6 +57,11 @@ struct DualFisheyeSplittingOptions {
   std::string lens_names = "lens0,lens1";
   // "cx,cy,r;cx,cy,r" in lens image pixels; empty: detect them.
   std::string circles;
+  // A camera preset (rig_preset --camera list): its circles at the frames'
+  // size (a size it does not know is refused) and its rig config (lens
+  // poses, the starting model), in place of circles, camera_model and
+  // camera_params.
+  std::string camera;
   // Intensity (8-bit scale) at or below which a pixel is black: pixels this
   // dark inside the circle at its rim say nothing about the frame, and a
   // circle on a black surround is located to the pixel.

@@ -38,6 +38,10 @@ int RunDualFisheyeSplitter(int argc, char** argv) {
                            "\"cx,cy,r;cx,cy,r\" image circles of the left "
                            "and right lens in lens image pixels (may reach "
                            "past the image's edges); empty = detect");
+  options.AddDefaultOption("camera",
+                           &splitting.camera,
+                           "a camera preset (rig_preset --camera list): its "
+                           "circles and rig config");
   options.AddDefaultOption("black_level",
                            &splitting.black_level,
                            "intensity (8-bit scale) at or below which a "
