@@ -4,11 +4,14 @@ too (models, rotations, running colmap and sphera_render) is in
 scripts/sphera_common.py."""
 import os
 import random
+import resource
 import shutil
 import sqlite3
 import struct
+import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 from sphera_common import RENDER, SHARED_DATA_DIR
@@ -17,6 +20,49 @@ SHARED_DATA = os.environ.get("SPHERA_SHARED_DATA", SHARED_DATA_DIR)
 
 # ctest reports a test that exits with this code as skipped.
 SKIP_EXIT_CODE = 77
+
+
+def _timed_run(run):
+    """subprocess.run that appends a line to the file SPHERA_TEST_TIMES for
+    every program it runs: seconds of wall time and of CPU time (user and
+    system, all threads), the test method that ran it, the program and its
+    first argument (colmap's command)."""
+    def timed(args, *rest, **options):
+        start = time.monotonic()
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        try:
+            return run(args, *rest, **options)
+        finally:
+            seconds = time.monotonic() - start
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = (after.ru_utime + after.ru_stime - before.ru_utime -
+                   before.ru_stime)
+            frame, caller = sys._getframe(1), "-"
+            while frame is not None:
+                if isinstance(frame.f_locals.get("self"), unittest.TestCase):
+                    caller = frame.f_locals["self"].id()
+                    break
+                frame = frame.f_back
+            if frame is None:
+                frame = sys._getframe(1)
+                while frame.f_back is not None and frame.f_code.co_name in (
+                        "run_program", "run_colmap", "run_render",
+                        "extract_features", "match_exhaustive"):
+                    frame = frame.f_back
+                caller = frame.f_code.co_name
+            words = [str(a) for a in (args if isinstance(args, (list, tuple))
+                                      else [args])]
+            program = os.path.basename(words[0])
+            with open(os.environ["SPHERA_TEST_TIMES"], "a") as log:
+                log.write(f"{seconds:8.2f} {cpu:8.2f} {caller} {program} "
+                          f"{words[1] if len(words) > 1 else ''}\n")
+    return timed
+
+
+# Profiling: SPHERA_TEST_TIMES=FILE logs the wall and CPU seconds of every
+# program a test runs (colmap, sphera_render) to FILE.
+if os.environ.get("SPHERA_TEST_TIMES"):
+    subprocess.run = _timed_run(subprocess.run)
 
 
 def write_noise_image(path, width, height, seed, gray=True):
