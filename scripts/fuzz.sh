@@ -28,6 +28,9 @@
 #   fuzz_calibration_import  calibration_importer's readers of Kalibr,
 #                        OpenCV, OCamCalib and Basalt files (calibration/,
 #                        instrumented; yaml-cpp, OpenCV and Ceres from Debian)
+#   fuzz_camera_presets  the camera presets' lookup and rig_preset's option
+#                        checks (calibration/camera_presets.cc, built as
+#                        fuzz_calibration_import)
 #
 # Each target starts from seeds made here from a rendered scene (a small
 # database of two images, a JPEG and a PNG; a small valid model in both
@@ -46,7 +49,7 @@ readonly COLMAP="${BUILD_DIR}/bin/colmap"
 readonly RENDER="${BUILD_DIR}/synthetic/sphera_render"
 readonly ALL_TARGETS=(fuzz_database_check fuzz_image_bytes fuzz_camera_params
                       fuzz_model_readers fuzz_rig_config
-                      fuzz_calibration_import)
+                      fuzz_calibration_import fuzz_camera_presets)
 # COLMAP's log lines of every rejected input would cost most of the time.
 export GLOG_minloglevel=3
 
@@ -57,7 +60,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --runs) runs="$2"; shift 2 ;;
     --minutes) minutes="$2"; shift 2 ;;
-    -h|--help) sed -n '2,28p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,31p' "$0"; exit 0 ;;
     fuzz_*) targets+=("$1"); shift ;;
     *) echo "fuzz.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
@@ -94,7 +97,7 @@ build_target() {
   case "${target}" in
     fuzz_image_bytes)
       sources=("${REPO_ROOT}/colmap_ext/image/image_file_structure.cc") ;;
-    fuzz_calibration_import)
+    fuzz_calibration_import|fuzz_camera_presets)
       # shellcheck disable=SC2207
       sources=($(ls "${REPO_ROOT}"/calibration/*.cc | grep -v _test.cc)
                -I /usr/include/opencv4 -lopencv_core -lyaml-cpp -lceres -lglog) ;;
@@ -274,9 +277,23 @@ distortion_coefficients: !!opencv-matrix
 ' > "${seeds}/basalt"
 }
 
+# Seeds of fuzz_camera_presets: the lines --camera, --resolution,
+# --image_width, --image_height and a resolution name, as rig_preset gets
+# them; written every run.
+make_preset_seeds() {
+  local seeds="${WORK}/seeds/fuzz_camera_presets"
+  mkdir -p "${seeds}"
+  printf 'gopro_fusion\nphoto\n\n\n5.2k\n' > "${seeds}/by_name"
+  printf 'insta360_x3\n\n5952\n2976\n11968x5984\n' > "${seeds}/by_size"
+  printf 'dual_fisheye\n4000x2000\n\n\n8k\n' > "${seeds}/generic"
+  printf 'VUZE\n\n\n\nlens\n' > "${seeds}/vuze"
+  printf 'theta\n3k\n-1\n7\n0x0\n' > "${seeds}/bad"
+}
+
 # -- run --------------------------------------------------------------------
 make_seeds
 make_calibration_seeds
+make_preset_seeds
 for target in "${targets[@]}"; do
   build_target "${target}"
 done
