@@ -6,6 +6,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "calibration/camera_presets.h"
 #include "colmap/scene/rig.h"
