@@ -1,5 +1,6 @@
 // The files SPHERA's renderer writes and its commands read: image files
-// recognised by the extension of their names, and range maps. Header-only
+// recognised by the extension of their names, JSON number lists and range
+// maps. Header-only
 // (standard library and OpenCV's codec constants), so that the COLMAP
 // commands share these definitions without linking the renderer.
 #pragma once
@@ -9,6 +10,8 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <iomanip>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -73,6 +76,18 @@ inline std::vector<int> ImageWriteParams(const std::string& name,
     return {cv::IMWRITE_JPEG_QUALITY, jpeg_quality > 0 ? jpeg_quality : 95};
   }
   return {};
+}
+
+// "[v0, v1, ...]" with every value to full double precision: the number
+// lists of the JSON files (rig configs, reports) SPHERA writes.
+inline std::string JsonList(const std::vector<double>& values) {
+  std::ostringstream out;
+  out << std::setprecision(17) << "[";
+  for (size_t i = 0; i < values.size(); ++i) {
+    out << (i ? ", " : "") << values[i];
+  }
+  out << "]";
+  return out.str();
 }
 
 // A range map (NAME.depth.bin beside a rendered image): int32 width, int32

@@ -70,14 +70,6 @@ std::string FrameName(int frame, const std::string& extension) {
   return name.str();
 }
 
-std::string JsonList(const std::vector<double>& values) {
-  std::ostringstream out;
-  out << std::setprecision(17) << "[";
-  for (size_t i = 0; i < values.size(); ++i) out << (i ? ", " : "") << values[i];
-  out << "]";
-  return out.str();
-}
-
 std::string WriteText(const fs::path& path, const std::string& text) {
   std::ofstream file(path);
   file << text;

@@ -238,10 +238,9 @@ void WriteImage(const std::string& path,
 std::string SphereUndistorterOptions::Parse(
     ParsedSphereUndistorterOptions* parsed) const {
   std::ostringstream message;
-  if (face_size < 0) {
-    message << "face_size must be positive, or 0 to pick it automatically; "
-               "got "
-            << face_size;
+  if (face_size < 0 || face_size > kMaxFaceSize) {
+    message << "face_size must be in [1, " << kMaxFaceSize
+            << "] pixels, or 0 to pick it automatically; got " << face_size;
   } else if (!(fov_deg > 0 && fov_deg < 180)) {
     message << "fov_deg must be in (0, 180) degrees, got " << fov_deg;
   } else if (!(overlap_deg >= 0)) {

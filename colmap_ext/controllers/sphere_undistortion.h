@@ -49,6 +49,8 @@ struct ParsedSphereUndistorterOptions {
 };
 
 struct SphereUndistorterOptions {
+  // The largest face side accepted (a face of 16384² RGB pixels is 768 MiB).
+  static constexpr int kMaxFaceSize = 16384;
   // Side of the square cube faces in pixels; 0 picks it per source camera:
   // w/4 * tan(fov/2) for EQUIRECTANGULAR (w/4 at 90 degrees), otherwise the
   // source's resolution at its centre (focal length 1 / radians per pixel).

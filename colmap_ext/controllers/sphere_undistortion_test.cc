@@ -354,6 +354,9 @@ TEST(SphereUndistorter, BadOptionsAreNamed) {
   };
   EXPECT_NE(check([](auto* o) { o->face_size = -1; }).find("face_size"),
             std::string::npos);
+  EXPECT_NE(check([](auto* o) { o->face_size = 100000; }).find("face_size"),
+            std::string::npos);
+  EXPECT_EQ(check([](auto* o) { o->face_size = 16384; }), "");
   for (const double fov : {0.0, -10.0, 180.0, 200.0, std::nan("")}) {
     EXPECT_NE(check([&](auto* o) { o->fov_deg = fov; }).find("fov_deg"),
               std::string::npos)

@@ -1,5 +1,5 @@
 // Writing result files so that a failed or killed run never leaves a file
-// that looks complete, and the JSON number lists those files hold.
+// that looks complete.
 #pragma once
 
 #include <cstdio>
@@ -15,6 +15,8 @@
 #include <vector>
 
 #include <unistd.h>
+
+#include "synthetic/file_formats.h"
 
 namespace colmap {
 
@@ -190,15 +192,6 @@ inline void WriteTextFilesAtomically(
   WriteFilesAtomically(folder, files);
 }
 
-// "[v0, v1, ...]" with every value to full double precision.
-inline std::string JsonList(const std::vector<double>& values) {
-  std::ostringstream out;
-  out << std::setprecision(17) << "[";
-  for (size_t i = 0; i < values.size(); ++i) {
-    out << (i ? ", " : "") << values[i];
-  }
-  out << "]";
-  return out.str();
-}
+using sphera::JsonList;
 
 }  // namespace colmap
