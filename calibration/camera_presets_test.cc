@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "camera_models/projection_check.h"
 #include "camera_models/registry.h"
 
 namespace sphera {
@@ -75,6 +76,12 @@ TEST(CameraPresets, EveryLensModelPassesItsChecks) {
         EXPECT_EQ(camera.model_id, ModelIdFromName(preset.model_name)) << where;
         EXPECT_EQ(CheckParams(camera.model_id, camera.params, camera.width,
                               camera.height),
+                  "")
+            << where;
+        // What COLMAP's camera checks ask of it too: a projection that
+        // inverts over the whole image.
+        EXPECT_EQ(ProjectionOverImageError(camera.model_id, camera.params,
+                                           camera.width, camera.height),
                   "")
             << where;
         if (preset.storage == LensStorage::kEquirectangular) continue;
