@@ -10,7 +10,8 @@ photos, one folder per lens), `dual_fisheye_splitter --camera gopro_fusion`
 splits every frame with the preset's circles (the maker's), masks exactly
 their part inside the frame, and writes the preset's rig config; a frame
 of a size the preset does not know is refused, naming it. Those tests are
-skipped, saying so, when the data set is absent."""
+skipped, saying so, when the data set is absent; side-by-side frames made
+here are split with the generic preset everywhere."""
 import json
 import os
 import re
@@ -22,7 +23,8 @@ import numpy as np
 from PIL import Image
 
 from cli_util import SHARED_DATA, Database, TempDirTestCase, listing
-from dual_fisheye_split_test import inside_mask, read_maker_circles
+from dual_fisheye_split_test import (inside_mask, load, make_raw,
+                                     read_maker_circles, save)
 from sphera_common import run_colmap
 
 REAL = os.path.join(SHARED_DATA, "real_cameras")
@@ -141,6 +143,54 @@ class RigPresetTest(TempDirTestCase):
                                                rtol=1e-12, err_msg=image)
         finally:
             db.close()
+
+    def test_side_by_side_frames_with_the_generic_preset(self):
+        """Side-by-side frames split with --camera dual_fisheye: the
+        circles inscribed in the halves, the preset's rig config beside the
+        images; a frame of a size the preset refuses is named."""
+        size = 96
+        circle = (size / 2, size / 2, size / 2)
+        for i in range(2):
+            save(self.path("raw", f"f{i}.png"),
+                 make_raw(i, circles=[circle, circle], width=size,
+                          height=size))
+        output = self.path("split")
+        run_colmap("dual_fisheye_splitter", "--input_path", self.path("raw"),
+                   "--output_path", output, "--camera", "dual_fisheye")
+        with open(os.path.join(output, "circles.txt")) as f:
+            rows = [line.split() for line in f if not line.startswith("#")]
+        self.assertEqual([(row[0], tuple(float(v) for v in row[1:]))
+                          for row in rows],
+                         [("lens0", circle), ("lens1", circle)])
+        for lens in ("lens0", "lens1"):
+            for i in range(2):
+                mask = load(os.path.join(output, "masks", lens,
+                                         f"f{i}.png.png"))
+                np.testing.assert_array_equal(
+                    mask, np.where(inside_mask(size, size, circle), 255, 0))
+        with open(os.path.join(output, "rig_config.json")) as f:
+            cameras = json.load(f)[0]["cameras"]
+        self.assertEqual([c["image_prefix"] for c in cameras],
+                         ["lens0/", "lens1/"])
+        self.assertEqual(cameras[1]["cam_from_rig_rotation"], [0, 0, 1, 0])
+        for camera in cameras:
+            self.assertEqual(camera["camera_model_name"], "DOUBLE_SPHERE")
+            self.assertAlmostEqual(camera["camera_params"][2], circle[0],
+                                   delta=0.5)
+            self.assertAlmostEqual(camera["camera_params"][3], circle[1],
+                                   delta=0.5)
+
+        save(self.path("odd", "odd.png"),
+             make_raw(5, circles=[circle, circle], width=size,
+                      height=size - 8))
+        refused = self.path("refused")
+        result = run_colmap("dual_fisheye_splitter", "--input_path",
+                            self.path("odd"), "--output_path", refused,
+                            "--camera", "dual_fisheye", check=False)
+        self.assertEqual(result.returncode, 1)
+        for needle in ("odd.png", f"{2 * size}x{size - 8}", "W = 2 H"):
+            self.assertIn(needle, result.stdout)
+        self.assertFalse(os.path.exists(refused))
 
     def test_bad_input(self):
         output = self.path("rig_config.json")
