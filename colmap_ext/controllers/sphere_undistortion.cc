@@ -9,6 +9,7 @@
 #include "colmap/sensor/models.h"
 #include "colmap/util/logging.h"
 #include "colmap/util/timer.h"
+#include "colmap_ext/image/image_file_structure.h"
 #include "colmap_ext/util/file_output.h"
 #include "synthetic/file_formats.h"
 #include "colmap/util/types.h"
@@ -18,6 +19,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <set>
@@ -908,9 +910,19 @@ std::string MissingImageFiles(const Reconstruction& reconstruction,
   std::vector<std::string> missing;
   for (const image_t image_id : image_ids) {
     const std::string& name = reconstruction.Image(image_id).Name();
+    const fs::path file = fs::path(image_path) / name;
     std::error_code error;
-    if (!fs::is_regular_file(fs::path(image_path) / name, error)) {
+    if (!fs::is_regular_file(file, error)) {
       missing.push_back(name);
+      continue;
+    }
+    // A JPEG or PNG cut short or overwritten decodes with gray where its
+    // data is missing; it is named instead of exported.
+    std::ifstream stream(file, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(stream)),
+                            std::istreambuf_iterator<char>());
+    if (const std::string damage = ImageBytesError(bytes); !damage.empty()) {
+      return "image " + name + ": " + file.string() + " " + damage;
     }
   }
   if (missing.empty()) {

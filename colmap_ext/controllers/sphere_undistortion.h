@@ -207,8 +207,10 @@ SphereExportSummary ExportPerspectiveWorkspace(
     const SphereUndistorterOptions& options);
 
 // "image NAME not found in IMAGE_PATH (and N more missing images)" for the
-// first of `image_ids` whose file is not under `image_path`; empty when every
-// file is there. Used by both undistorters before they write anything.
+// first of `image_ids` whose file is not under `image_path`, or "image NAME:
+// FILE <damage>" for a JPEG or PNG file that is not a whole image
+// (ImageBytesError); empty when every file is there and whole. Used by both
+// undistorters before they write anything.
 std::string MissingImageFiles(const Reconstruction& reconstruction,
                               const std::vector<image_t>& image_ids,
                               const std::string& image_path);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <random>
@@ -943,6 +944,21 @@ TEST(SphereUndistorter, FailuresLeaveNothingBehind) {
   bad = SphereUndistorterOptions();
   bad.faces = "front,top";
   expect_failure(bad, "top");
+
+  // The second image is a PNG cut in half: named before anything is
+  // written (a decoder would fill the missing half with gray).
+  {
+    const fs::path png = image_dir / "pano1.png";
+    std::string bytes;
+    {
+      std::ifstream in(png.string(), std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    ASSERT_GT(bytes.size(), 100u);
+    std::ofstream(png.string(), std::ios::binary | std::ios::trunc)
+        << bytes.substr(0, bytes.size() / 2);
+    expect_failure(SphereUndistorterOptions(), "image pano1.png: ");
+  }
 
   // The second image is unreadable: the first one was already written
   // into the temporary folder, which must disappear.
