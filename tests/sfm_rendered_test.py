@@ -1,11 +1,13 @@
 """Incremental SfM on rays, end to end through the colmap program, on scenes
 rendered by sphera_render with exact ground truth: the SPHERA paper's room
-seen by 9 equirectangular cameras, and a hybrid set of equirectangular,
-190° fisheye and pinhole cameras."""
+seen by 9 equirectangular cameras (the shared scene room9_equirect, whose
+database sphere_models_test maps with the global mapper), and a hybrid set
+of equirectangular, 190° fisheye and pinhole cameras."""
 import json
 import os
 
 from cli_util import TempDirTestCase, main_with_render
+from scenes import shared_scene
 from sphera_common import (extract_features, hybrid_rig, match_exhaustive,
                            model_to_text, read_text_cameras,
                            read_text_images, run_colmap, run_render,
@@ -17,16 +19,19 @@ def render(output, *args):
 
 
 class RenderedSfMTest(TempDirTestCase):
-    def reconstruct(self, scene, image_lists):
-        """image_lists: [(camera model, params, [image names])]."""
-        database = self.path("database.db")
-        for index, (model, params, names) in enumerate(image_lists):
-            list_path = self.path(f"list{index}.txt")
-            with open(list_path, "w") as f:
-                f.write("\n".join(names) + "\n")
-            extract_features(database, os.path.join(scene, "images"), model,
-                             "--image_list_path", list_path, params=params)
-        match_exhaustive(database)
+    def reconstruct(self, scene, image_lists, database=None):
+        """image_lists: [(camera model, params, [image names])], extracted
+        and matched into a new database unless DATABASE holds them."""
+        if database is None:
+            database = self.path("database.db")
+            for index, (model, params, names) in enumerate(image_lists):
+                list_path = self.path(f"list{index}.txt")
+                with open(list_path, "w") as f:
+                    f.write("\n".join(names) + "\n")
+                extract_features(database, os.path.join(scene, "images"),
+                                 model, "--image_list_path", list_path,
+                                 params=params)
+            match_exhaustive(database)
         os.makedirs(self.path("sparse"))
         run_colmap("mapper", "--database_path", database, "--image_path",
                    os.path.join(scene, "images"), "--output_path",
@@ -57,10 +62,14 @@ class RenderedSfMTest(TempDirTestCase):
                 for camera_id, names in sorted(groups.items())]
 
     def test_paper_room_nine_equirectangular_cameras(self):
-        scene = self.path("room9")
-        render(scene, "--layout", "room9", "--model", "EQUIRECTANGULAR",
-               "--width", 2048, "--height", 1024, "--supersample", 3)
-        result = self.reconstruct(scene, self.gt_image_lists(scene))
+        # 2048 x 1024 panoramas, 3 x 3 rays a pixel, extracted as one
+        # EQUIRECTANGULAR camera and matched exhaustively.
+        room9 = shared_scene("room9_equirect")
+        self.assertEqual(room9.model, "EQUIRECTANGULAR")
+        self.assertEqual(room9.params, [2048.0, 1024.0])
+        result = self.reconstruct(
+            room9.path, None,
+            database=room9.copy_database(self.path("database.db")))
         print(json.dumps({k: v for k, v in result.items()
                           if k not in ("images", "cameras")}, indent=1))
         # RANSAC is randomised: the bounds hold the paper-setup targets

@@ -4,13 +4,16 @@ through lenses beyond 180 degrees (UNIFIED_OMNI 190 degrees, EUCM and
 DOUBLE_SPHERE 200 degrees) are extracted, matched and mapped, every image is
 registered, the poses agree with the ground truth, and the model holds points
 that are seen behind a lens plane (rays upstream's models cannot represent).
+The 190-degree room and the equirectangular room are shared scenes
+(scenes.py), each rendered, extracted and matched once per test run.
 """
 import os
 
 import numpy as np
 
 from cli_util import TempDirTestCase, main_with_render
-from sphera_common import (cam_from_world, extract_features, fisheye190_rig,
+from scenes import shared_scene
+from sphera_common import (cam_from_world, extract_features,
                            match_exhaustive, model_to_text, pose_errors,
                            read_text_model, rig_line, run_colmap, run_render,
                            write_rig)
@@ -34,11 +37,16 @@ def ring_of_200_degree_lenses(model, params):
 
 
 class SphereModelsOnColmap4Test(TempDirTestCase):
-    def reconstruct(self, scene, model, params, mapper="mapper"):
-        database = self.path("database.db")
-        extract_features(database, os.path.join(scene, "images"), model,
-                         params=params)
-        match_exhaustive(database)
+    def reconstruct(self, scene, model, params, mapper="mapper",
+                    database=None):
+        """Extracts and matches the images of SCENE as one camera MODEL of
+        PARAMS, unless DATABASE holds them, maps them with MAPPER, and
+        returns the text model."""
+        if database is None:
+            database = self.path("database.db")
+            extract_features(database, os.path.join(scene, "images"), model,
+                             params=params)
+            match_exhaustive(database)
         os.makedirs(self.path("sparse"))
         run_colmap(mapper, "--database_path", database, "--image_path",
                    os.path.join(scene, "images"), "--output_path",
@@ -78,34 +86,40 @@ class SphereModelsOnColmap4Test(TempDirTestCase):
         self.assertLess(np.mean(position), max_mean_position)
         self.assertGreater(behind, 100)
 
+    def shared(self, name, model):
+        """The shared scene NAME (its camera MODEL) and a copy of its
+        database."""
+        scene = shared_scene(name)
+        self.assertEqual(scene.model, model)
+        return scene, scene.copy_database(self.path("database.db"))
+
     def test_unified_omni_190_degree_room(self):
         # The SfM benchmark's room_fisheye190 set; SPHERA on its former
         # COLMAP base measured 0.0034 degrees and 0.21 mm there.
-        scene = self.path("fisheye190")
-        render(scene, fisheye190_rig())
-        cameras, _, _ = read_text_model(os.path.join(scene, "sparse_gt"))
-        params = next(iter(cameras.values()))[3]
-        model_path = self.reconstruct(scene, "UNIFIED_OMNI", params)
-        self.check(scene, model_path, 12, 0.02, 0.002)
+        scene, database = self.shared("fisheye190", "UNIFIED_OMNI")
+        model_path = self.reconstruct(scene.path, scene.model, scene.params,
+                                      database=database)
+        self.check(scene.path, model_path, 12, 0.02, 0.002)
 
     def test_global_mapper_190_degree_room(self):
         # The global mapper (rotation averaging, global positioning, bundle
-        # adjustment) on the same lenses.
-        scene = self.path("fisheye190")
-        render(scene, fisheye190_rig())
-        cameras, _, _ = read_text_model(os.path.join(scene, "sparse_gt"))
-        params = next(iter(cameras.values()))[3]
-        model_path = self.reconstruct(scene, "UNIFIED_OMNI", params,
-                                      mapper="global_mapper")
-        self.check(scene, model_path, 12, 0.05, 0.005)
+        # adjustment) on the same lenses, the same extracted and matched
+        # database.
+        scene, database = self.shared("fisheye190", "UNIFIED_OMNI")
+        model_path = self.reconstruct(scene.path, scene.model, scene.params,
+                                      mapper="global_mapper",
+                                      database=database)
+        self.check(scene.path, model_path, 12, 0.05, 0.005)
 
     def test_global_mapper_equirectangular_room(self):
-        scene = self.path("room9")
-        run_render(scene, "--seed", "7", "--layout", "room9", "--model",
-                   "EQUIRECTANGULAR", "--width", "2048", "--height", "1024",
-                   "--supersample", "2")
-        model_path = self.reconstruct(scene, "EQUIRECTANGULAR", [2048, 1024],
-                                      mapper="global_mapper")
+        # The 2048 x 1024 panoramas of sfm_rendered_test's paper room (3 x 3
+        # rays a pixel), its extracted and matched database.
+        room9, database = self.shared("room9_equirect", "EQUIRECTANGULAR")
+        self.assertEqual(room9.params, [2048.0, 1024.0])
+        scene = room9.path
+        model_path = self.reconstruct(scene, room9.model, room9.params,
+                                      mapper="global_mapper",
+                                      database=database)
         errors = pose_errors(os.path.join(scene, "sparse_gt"), model_path)
         rotation = [e[0] for e in errors.values()]
         position = [e[1] for e in errors.values()]
