@@ -36,6 +36,21 @@ Usage (from the repository root, after scripts/build.sh):
                                                   self-calibration: the rig
                                                   starts from focal lengths
                                                   20% long, no distortion
+Lenses that lie like real ones (the real-lenses issue):
+  --lens kb       every lens of the preset drawn through a Kannala-Brandt
+                  polynomial of a real-lens-like shape (OPENCV_FISHEYE over
+                  its whole field, 200° or 195°), not one of the models the
+                  mapper fits
+  --realistic     sphera_render's sensor effects (cropped circles, housing,
+                  vignetting, flare, per-lens exposure and white balance,
+                  noise, JPEG)
+  --fit_model M   the rig starts from model M (EUCM, DOUBLE_SPHERE or
+                  UNIFIED_OMNI) with rough intrinsics from each lens's image
+                  circle and field of view (principal point at the image
+                  centre, focal length so that the field's edge lands on the
+                  circle) and zero offsets, and self-calibrates
+  scripts/benchmark_rig.py --systems rig --lens kb --realistic \
+      --fit_model DOUBLE_SPHERE --repeats 5 --output build/bench_rig_kb
 Output (--output, default build/bench_rig): rig_runs.csv (every run),
 rig_results.csv (median and min..max per preset and system, ratios to the
 rig), rig_results.png, logs/.
@@ -98,8 +113,88 @@ def rough_rig_config(scene, path, focal_scale=1.0, no_distortion=False):
         json.dump(config, f, indent=1)
 
 
+# Real-lens-like Kannala-Brandt shape r = f (t + k1 t^3 + k2 t^5 + k3 t^7 +
+# k4 t^9): slightly compressed towards the rim, monotone to 110 degrees.
+KB_COEFFICIENTS = (-0.012, 0.0016, -0.0002, 0.0)
+# Half fields of view of the presets' lenses, degrees.
+PRESET_HALF_FIELD_DEG = {"dual_fisheye": 100.0, "ring8": 97.5}
+
+
+def kb_radius(f, theta, k=KB_COEFFICIENTS):
+    return f * (theta + k[0] * theta ** 3 + k[1] * theta ** 5 +
+                k[2] * theta ** 7 + k[3] * theta ** 9)
+
+
+def kb_sensors_file(layout_config, lens_size, half_field_deg, path):
+    """A --rig_sensors file of the preset's lenses (their poses from the
+    preset's LAYOUT_CONFIG, a rig_config.json list) drawn through the
+    Kannala-Brandt shape above, the field's edge at 0.48 of LENS_SIZE from
+    the image centre."""
+    import math
+    theta = math.radians(half_field_deg)
+    f = 0.48 * lens_size / kb_radius(1.0, theta)
+    c = lens_size / 2.0
+    lines = []
+    for camera in layout_config[0]["cameras"]:
+        q = camera.get("cam_from_rig_rotation", [1, 0, 0, 0])
+        t = camera.get("cam_from_rig_translation", [0, 0, 0])
+        params = [f, f, c, c, *KB_COEFFICIENTS]
+        lines.append(" ".join(
+            [camera["image_prefix"].rstrip("/"), "OPENCV_FISHEYE",
+             str(lens_size), str(lens_size), *("%.17g" % v for v in params),
+             "|", *("%.17g" % v for v in (*q, *t)),
+             "%.17g" % half_field_deg]))
+    with open(path, "w") as f_out:
+        f_out.write("\n".join(lines) + "\n")
+
+
+def rough_start(model, width, height, circle_radius, half_field_deg):
+    """Parameters of MODEL that a user has from a spec sheet: the principal
+    point at the image centre and the focal length that puts the edge of
+    the field on the image circle, the model's generic fisheye shape (EUCM
+    alpha 0.5, beta 1; DOUBLE_SPHERE xi 0, alpha 0.5: both r = 2 f tan(t/2);
+    UNIFIED_OMNI xi 1 without distortion: r = f tan(t/2))."""
+    import math
+    half_tan = math.tan(math.radians(half_field_deg) / 2)
+    cx, cy = width / 2.0, height / 2.0
+    if model == "UNIFIED_OMNI":
+        f = circle_radius / half_tan
+        return [f, f, cx, cy, 1.0, 0.0, 0.0, 0.0, 0.0]
+    f = circle_radius / (2 * half_tan)
+    if model == "EUCM":
+        return [f, f, cx, cy, 0.5, 1.0]
+    if model == "DOUBLE_SPHERE":
+        return [f, f, cx, cy, 0.0, 0.5]
+    raise ValueError(f"--fit_model {model}: one of EUCM, DOUBLE_SPHERE, "
+                     "UNIFIED_OMNI")
+
+
+def fitted_rig_config(scene, path, model, half_field_deg):
+    """The scene's rig_config.json with zero offsets and every lens started
+    from MODEL's rough parameters (rough_start) on its image circle."""
+    import json
+    with open(os.path.join(scene, "rig_config.json")) as f:
+        config = common.without_rig_offsets(json.load(f))
+    circles = {}
+    with open(os.path.join(scene, "circles.txt")) as f:
+        for line in f:
+            if line.strip() and not line.startswith("#"):
+                name, _, _, radius = line.split()
+                circles[name] = float(radius)
+    _, width, height, _ = next(iter(common.read_text_cameras(
+        os.path.join(scene, "sparse_gt")).values()))
+    for rig in config:
+        for camera in rig["cameras"]:
+            lens = camera["image_prefix"].rstrip("/")
+            camera["camera_model_name"] = model
+            camera["camera_params"] = rough_start(
+                model, width, height, circles[lens], half_field_deg)
+    with open(path, "w") as f:
+        json.dump(config, f, indent=1)
+
+
 def run_system(scene, preset, system, work, program, num_lenses,
-               start=(1.0, False)):
+               start=(1.0, False), fit_model=""):
     """Reconstructs SCENE with SYSTEM; returns a row of results."""
     import json
     os.makedirs(work)
@@ -114,12 +209,17 @@ def run_system(scene, preset, system, work, program, num_lenses,
         image_path = os.path.join(scene, "images")
         t_extract = timed(program, [
             "feature_extractor", "--database_path", database, "--image_path",
-            image_path, "--ImageReader.camera_model", lens0["camera_model_name"],
+            image_path, "--ImageReader.camera_model",
+            fit_model or lens0["camera_model_name"],
             "--ImageReader.single_camera_per_folder", "1",
             "--ImageReader.mask_path", os.path.join(scene, "masks"),
             *extraction], os.path.join(logs, "extract.log"))
         config = os.path.join(work, "rig_config.json")
-        rough_rig_config(scene, config, *start)
+        if fit_model:
+            fitted_rig_config(scene, config, fit_model,
+                              PRESET_HALF_FIELD_DEG[preset])
+        else:
+            rough_rig_config(scene, config, *start)
         t_extract += timed(program, [
             "rig_configurator", "--database_path", database,
             "--rig_config_path", config], os.path.join(logs, "rig.log"))
@@ -351,6 +451,14 @@ def main():
     parser.add_argument("--start_no_distortion", action="store_true",
                         help="the rig's start: distortion unknown "
                              "(sphera_common.rough_intrinsics)")
+    parser.add_argument("--lens", choices=("preset", "kb"), default="preset",
+                        help="kb: lenses drawn through a Kannala-Brandt "
+                             "polynomial, not a fitted model")
+    parser.add_argument("--realistic", action="store_true",
+                        help="sphera_render's sensor effects")
+    parser.add_argument("--fit_model", default="",
+                        help="the rig starts from this model's rough "
+                             "parameters (EUCM, DOUBLE_SPHERE, UNIFIED_OMNI)")
     parser.add_argument("--supersample", type=int, default=2,
                         help="rays per pixel side of the renders")
     parser.add_argument("--output", default=os.path.join(REPO, "build",
@@ -392,10 +500,29 @@ def main():
             scene = os.path.join(args.output, f"scene_{preset}_{seed}")
             if not os.path.exists(os.path.join(scene, "sparse_gt")):
                 shutil.rmtree(scene, ignore_errors=True)
-                render = ["--rig_preset", preset, "--frames", args.frames,
-                          "--seed", seed, "--supersample", args.supersample]
-                if args.lens_size:
-                    render += ["--lens_size", args.lens_size]
+                render = ["--frames", args.frames, "--seed", seed,
+                          "--supersample", args.supersample]
+                if args.lens == "kb":
+                    # The preset's lens poses, from a one-frame render.
+                    import json
+                    layout = scene + "_layout"
+                    shutil.rmtree(layout, ignore_errors=True)
+                    common.run_render(layout, "--rig_preset", preset,
+                                      "--frames", 1, "--lens_size", 64,
+                                      "--supersample", 1, program=args.render)
+                    with open(os.path.join(layout, "rig_config.json")) as f:
+                        layout_config = json.load(f)
+                    shutil.rmtree(layout, ignore_errors=True)
+                    sensors = scene + "_sensors.txt"
+                    kb_sensors_file(layout_config, args.lens_size or 640,
+                                    PRESET_HALF_FIELD_DEG[preset], sensors)
+                    render += ["--rig_sensors", sensors]
+                else:
+                    render += ["--rig_preset", preset]
+                    if args.lens_size:
+                        render += ["--lens_size", args.lens_size]
+                if args.realistic:
+                    render += ["--realistic"]
                 if preset == "dual_fisheye":
                     render += ["--stitched", "--stitched_width",
                                args.stitched_width]
@@ -414,7 +541,8 @@ def main():
                 try:
                     row = run_system(scene, preset, system, work, program,
                                      num_lenses, (args.start_focal_scale,
-                                                  args.start_no_distortion))
+                                                  args.start_no_distortion),
+                                     args.fit_model)
                 except (RuntimeError, OSError, ValueError) as error:
                     row = {"preset": preset, "system": system,
                            "error": str(error).splitlines()[0]}
