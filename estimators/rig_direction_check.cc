@@ -23,7 +23,7 @@ struct CombinedPair {
   int lens1 = -1;
   int lens2 = -1;
   Eigen::Matrix3d cam2_from_cam1 = Eigen::Matrix3d::Identity();
-  int num_frames = 0;
+  int num_measurements = 0;
   int num_inliers = 0;
   double disagreement_rad = 0;
 };
@@ -73,7 +73,7 @@ std::vector<LensDirection> CheckRigDirections(
     pair.lens1 = key.first;
     pair.lens2 = key.second;
     pair.cam2_from_cam1 = GeodesicMedianRotation(rotations);
-    pair.num_frames = static_cast<int>(rotations.size());
+    pair.num_measurements = static_cast<int>(rotations.size());
     pair.num_inliers = inliers_per_pair[key];
     pair.disagreement_rad = RotationAngle(
         pair.cam2_from_cam1, config_cam_from_rig[pair.lens2] *
@@ -82,7 +82,7 @@ std::vector<LensDirection> CheckRigDirections(
       LensDirection& direction = lenses[lens];
       direction.status = LensDirectionStatus::kConsistent;
       direction.num_pairs += 1;
-      direction.num_frames += pair.num_frames;
+      direction.num_measurements += pair.num_measurements;
       direction.num_inliers += pair.num_inliers;
       direction.max_pair_disagreement_rad =
           std::max(direction.max_pair_disagreement_rad, pair.disagreement_rad);

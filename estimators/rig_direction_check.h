@@ -56,10 +56,10 @@ struct LensDirection {
   Eigen::Matrix3d measured_cam_from_rig = Eigen::Matrix3d::Identity();
   // Angle between the measured and the config's cam_from_rig.
   double angle_off_rad = 0;
-  // Lens pairs measured (with any lens), the frames and inlier rays they
-  // came from.
+  // Lens pairs measured (with any lens), their measurements (one per pair
+  // and frame) and the inlier rays of those.
   int num_pairs = 0;
-  int num_frames = 0;
+  int num_measurements = 0;
   int num_inliers = 0;
   // The largest disagreement of its pairs with the config.
   double max_pair_disagreement_rad = 0;

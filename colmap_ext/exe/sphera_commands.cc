@@ -4,6 +4,7 @@
 #include "colmap_ext/exe/dual_fisheye_splitter.h"
 #include "colmap_ext/exe/model_evaluator.h"
 #include "colmap_ext/exe/rig_calibration.h"
+#include "colmap_ext/exe/rig_check.h"
 #include "colmap_ext/exe/rig_preset.h"
 #include "colmap_ext/exe/sphere_bundle_adjuster.h"
 #include "colmap_ext/exe/sphere_undistorter.h"
@@ -17,6 +18,7 @@ std::vector<std::pair<std::string, SpheraCommandFunc>> SpheraCommands() {
       {"dual_fisheye_splitter", &RunDualFisheyeSplitter},
       {"model_evaluator", &RunModelEvaluator},
       {"rig_calibration", &RunRigCalibration},
+      {"rig_check", &RunRigCheck},
       {"rig_preset", &RunRigPreset},
       {"sphere_bundle_adjuster", &RunSphereBundleAdjuster},
       {"sphere_undistorter", &RunSphereUndistorter},

@@ -27,15 +27,15 @@ std::vector<Eigen::Matrix3d> Ring(int num_lenses) {
   return cam_from_rig;
 }
 
-// Neighbouring lenses of the true ring measured in `num_frames` frames from
+// Neighbouring lenses of the true ring measured in `num_measurements` frames from
 // synthetic rays (scene points 2 m away, lenses 6 cm from the rig centre,
 // 20% wrong matches), through the robust estimator.
 std::vector<LensPairRotation> MeasureNeighbours(
-    const std::vector<Eigen::Matrix3d>& true_cam_from_rig, int num_frames,
+    const std::vector<Eigen::Matrix3d>& true_cam_from_rig, int num_measurements,
     std::mt19937* rng) {
   const int num_lenses = static_cast<int>(true_cam_from_rig.size());
   std::vector<LensPairRotation> measurements;
-  for (int frame = 0; frame < num_frames; ++frame) {
+  for (int frame = 0; frame < num_measurements; ++frame) {
     for (int lens1 = 0; lens1 < num_lenses; ++lens1) {
       const int lens2 = (lens1 + 1) % num_lenses;
       std::vector<Eigen::Vector3d> rays1, rays2;
@@ -84,7 +84,7 @@ TEST(RigDirectionCheck, CorrectConfigNamesNothing) {
     EXPECT_TRUE(lens.measured);
     EXPECT_LT(lens.angle_off_rad, 1.5 * kDeg);
     EXPECT_EQ(lens.num_pairs, 2);
-    EXPECT_EQ(lens.num_frames, 6);
+    EXPECT_EQ(lens.num_measurements, 6);
   }
 }
 
@@ -128,7 +128,7 @@ TEST(RigDirectionCheck, AWrongFrameDoesNotMoveAPair) {
   for (const LensDirection& lens : lenses) {
     EXPECT_EQ(lens.status, LensDirectionStatus::kConsistent);
     EXPECT_LT(lens.angle_off_rad, 1e-6);
-    EXPECT_EQ(lens.num_frames, 3);
+    EXPECT_EQ(lens.num_measurements, 3);
     EXPECT_EQ(lens.num_inliers, 60);
   }
 }
