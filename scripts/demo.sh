@@ -10,6 +10,17 @@
 #                                        scene rendered by sphera_render
 #                                        (SCENE/images) are evaluated against
 #                                        its ground truth (SCENE/sparse_gt)
+#   scripts/demo.sh --camera NAME DIR    a 360° camera's own files to a rig
+#                                        model (colmap rig_preset --camera
+#                                        list names the cameras): the frames
+#                                        split into lens images and masks
+#                                        (both lenses in one frame, or FR/ and
+#                                        BK/ folders), or the lens files read
+#                                        as they are (one file per lens); the
+#                                        preset's rig config; matching, the
+#                                        lens directions checked against the
+#                                        images (colmap rig_check), mapping
+#                                        and the rig's calibration
 #
 # It prints one line per stage with its counts (images extracted, pairs
 # verified, images registered), a progress line while a stage runs on a
@@ -41,6 +52,15 @@ else
 fi
 readonly LOG="${WORK_DIR}/demo.log"
 
+camera=""
+if [ "${1:-}" = "--camera" ]; then
+  if [ $# -ne 3 ]; then
+    echo "demo: usage: scripts/demo.sh --camera NAME DIR" >&2
+    exit 1
+  fi
+  camera="$2"
+  shift 2
+fi
 image_dir="${1:-}"
 camera_model="${2:-EQUIRECTANGULAR}"
 if [ -n "${image_dir}" ] && [ ! -d "${image_dir}" ]; then
@@ -133,13 +153,95 @@ fi
 
 database="${WORK_DIR}/database.db"
 start=$(date +%s)
+# A camera preset: the rig config, and the lens images and masks split from
+# the camera's frames where it stores both lenses in one frame or folder.
+rig_config=""
+mask_args=()
+if [ -n "${camera}" ]; then
+  # How the camera stores its lenses, from its line in the preset list.
+  preset_line="$("${COLMAP}" rig_preset --camera list 2>/dev/null \
+    | grep "^${camera}: " || true)"
+  case "${preset_line}" in
+    "") run_stage "camera preset" 's/^$//p' "${COLMAP}" rig_preset \
+          --camera "${camera}" --output_path "${WORK_DIR}/rig_config.json"
+        exit 1 ;;
+    *"stitched in the camera"*) preset_kind=stitched ;;
+    *"one file per lens"*)
+      preset_kind=files
+      run_stage "camera preset" 's/^$//p' "${COLMAP}" rig_preset \
+        --camera "${camera}" --output_path "${WORK_DIR}/preset_rig_config.json" ;;
+    *) preset_kind=frames ;;
+  esac
+  case "${preset_kind}" in
+    stitched)
+      camera_model=EQUIRECTANGULAR
+      echo "camera preset:      ${camera}: stitched panoramas, one camera" ;;
+    files)
+      rig_config="${WORK_DIR}/preset_rig_config.json"
+      camera_model="$(python3 -c 'import json, sys
+print(json.load(open(sys.argv[1]))[0]["cameras"][0]["camera_model_name"])' \
+        "${rig_config}")"
+      echo "camera preset:      ${camera}: one file per lens, rig config" \
+        "${rig_config}" ;;
+    frames)
+      if [ -d "${image_dir}/FR" ] && [ -d "${image_dir}/BK" ]; then
+        inputs=(--front_path "${image_dir}/FR" --back_path "${image_dir}/BK")
+      else
+        inputs=(--input_path "${image_dir}")
+      fi
+      # The generic preset's circles are a guess: the splitter finds the
+      # circles in the frames instead, and the lenses start from the
+      # preset's camera for the frames' size.
+      preset_args=(--camera "${camera}")
+      if [ "${camera}" = dual_fisheye ]; then
+        first_frame="$(find "${image_dir}" -maxdepth 1 -type f | sort | head -n 1)"
+        frame_size="$(python3 -c 'import struct, sys
+data = open(sys.argv[1], "rb").read(1 << 20)
+if data[:8] == b"\x89PNG\r\n\x1a\n":
+    w, h = struct.unpack(">II", data[16:24])
+else:
+    i = 2
+    while i < len(data) and not (data[i] == 0xFF and 0xC0 <= data[i + 1] <= 0xCF
+                                 and data[i + 1] not in (0xC4, 0xC8, 0xCC)):
+        i += 2 + struct.unpack(">H", data[i + 2:i + 4])[0]
+    h, w = struct.unpack(">HH", data[i + 5:i + 9])
+print(f"{w}x{h}")' "${first_frame}")"
+        run_stage "camera preset" 's/^$//p' "${COLMAP}" rig_preset \
+          --camera "${camera}" --resolution "${frame_size}" \
+          --output_path "${WORK_DIR}/preset_rig_config.json"
+        preset_args=($(python3 -c 'import json, sys
+c = json.load(open(sys.argv[1]))[0]["cameras"][0]
+print("--camera_model", c["camera_model_name"], "--camera_params",
+      ",".join("%.17g" % v for v in c["camera_params"]))' \
+          "${WORK_DIR}/preset_rig_config.json"))
+      fi
+      run_stage "splitting" 's/.*\[\([0-9]*\/[0-9]*\)\].*/\1 frames/p' \
+        "${COLMAP}" dual_fisheye_splitter ${preset_args[@]+"${preset_args[@]}"} \
+        "${inputs[@]}" --output_path "${WORK_DIR}/split"
+      image_dir="${WORK_DIR}/split/images"
+      rig_config="${WORK_DIR}/split/rig_config.json"
+      mask_args=(--ImageReader.mask_path "${WORK_DIR}/split/masks")
+      camera_model="$(python3 -c 'import json, sys
+print(json.load(open(sys.argv[1]))[0]["cameras"][0].get(
+    "camera_model_name", "DOUBLE_SPHERE"))' "${rig_config}")"
+      echo "splitting:          $(find "${image_dir}" -type f | wc -l) lens" \
+        "images and their masks (${stage_seconds} s)" ;;
+  esac
+fi
 run_stage "feature extraction" \
   's/.*Processed file \[\([0-9]*\/[0-9]*\)\].*/\1 images/p' \
   "${COLMAP}" feature_extractor --database_path "${database}" \
   --image_path "${image_dir}" --ImageReader.camera_model "${camera_model}" \
-  --ImageReader.single_camera_per_folder 1 --FeatureExtraction.use_gpu 0
+  --ImageReader.single_camera_per_folder 1 --FeatureExtraction.use_gpu 0 \
+  ${mask_args[@]+"${mask_args[@]}"}
 echo "feature extraction: $(sql 'SELECT COUNT(*) FROM images') images," \
   "$(sql 'SELECT SUM(rows) FROM keypoints') keypoints (${stage_seconds} s)"
+if [ -n "${rig_config}" ]; then
+  run_stage "rig configuration" 's/^$//p' "${COLMAP}" rig_configurator \
+    --database_path "${database}" --rig_config_path "${rig_config}"
+  echo "rig configuration:  $(sql 'SELECT COUNT(*) FROM rigs') rig(s)," \
+    "$(sql 'SELECT COUNT(*) FROM frames') frames (${stage_seconds} s)"
+fi
 
 run_stage "matching" 's/.*Processing block \[\(.*\)\].*/block \1/p' \
   "${COLMAP}" exhaustive_matcher --database_path "${database}" \
@@ -147,6 +249,13 @@ run_stage "matching" 's/.*Processing block \[\(.*\)\].*/block \1/p' \
 echo "matching:           $(sql 'SELECT COUNT(*) FROM two_view_geometries
   WHERE rows > 0') of $(sql 'SELECT COUNT(*) FROM matches') image pairs" \
   "verified (${stage_seconds} s)"
+
+if [ -n "${rig_config}" ]; then
+  run_stage "rig check" 's/^$//p' "${COLMAP}" rig_check \
+    --database_path "${database}"
+  echo "rig check:          the lens directions agree with the verified" \
+    "pairs inside frames (${stage_seconds} s)"
+fi
 
 mkdir -p "${WORK_DIR}/sparse"
 run_stage "mapping" \
@@ -164,6 +273,14 @@ for model in "${WORK_DIR}"/sparse/*/; do
 done
 echo "mapping:            ${registered:-0} of $(sql 'SELECT COUNT(*) FROM images')" \
   "images registered in ${models} model(s) (${stage_seconds} s)"
+if [ -n "${rig_config}" ] && [ -d "${WORK_DIR}/sparse/0" ]; then
+  mkdir -p "${WORK_DIR}/rig_calibration"
+  run_stage "rig calibration" 's/^$//p' "${COLMAP}" rig_calibration \
+    --input_path "${WORK_DIR}/sparse/0" \
+    --output_path "${WORK_DIR}/rig_calibration"
+  echo "rig calibration:    lens poses and intrinsics in" \
+    "${WORK_DIR}/rig_calibration (${stage_seconds} s)"
+fi
 elapsed=$(( $(date +%s) - start ))
 
 echo
@@ -186,4 +303,10 @@ for model in "${WORK_DIR}"/sparse/*/; do
     | grep -E "Cameras|Registered images|Points|Mean reprojection error" \
     | sed "s|^.*\] ||; s|^|$(basename "${model}"): |"
 done
+if [ -f "${WORK_DIR}/rig_calibration/rig_config.json" ]; then
+  echo "--- the rig (colmap rig_calibration) ---"
+  sed -n '/^=== rig calibration/,$p' "${LOG}" | awk '
+    /^  [^ ].* \(camera [0-9]+,/ { lens = $1 }
+    /pose in the rig:/ { sub(/.*pose in the rig: /, ""); print lens ": " $0 }'
+fi
 echo "log: ${LOG}"
