@@ -19,15 +19,24 @@ from sphera_common import (CPU_EXTRACTION, extract_features, match_exhaustive, m
                            rig_errors, rough_intrinsics, run_colmap, run_render)
 
 SCENE = None
+# The scene's lens images extracted once (DOUBLE_SPHERE, one camera per
+# lens folder, the image-circle masks): each test configures a copy.
+EXTRACTED = None
 FRAMES = 10
 
 
 def setUpModule():
-    global SCENE
+    global SCENE, EXTRACTED
     import tempfile
     SCENE = os.path.join(tempfile.mkdtemp(prefix="sphera_rig_"), "dual")
     run_render(SCENE, "--rig_preset", "dual_fisheye", "--frames", FRAMES,
                "--seed", "5", "--raw")
+    EXTRACTED = os.path.join(os.path.dirname(SCENE), "extracted.db")
+    extract_features(EXTRACTED, os.path.join(SCENE, "images"),
+                     "DOUBLE_SPHERE", "--ImageReader.mask_path",
+                     os.path.join(SCENE, "masks"),
+                     "--ImageReader.single_camera_per_folder", "1",
+                     single_camera=False)
 
 
 def tearDownModule():
@@ -221,12 +230,9 @@ class SuffixFramesTest(TempDirTestCase):
 
 class DualFisheyeRigTest(TempDirTestCase):
     def extract(self):
+        """A copy of the extracted database (setUpModule)."""
         database = self.path("database.db")
-        extract_features(database, os.path.join(SCENE, "images"),
-                         "DOUBLE_SPHERE", "--ImageReader.mask_path",
-                         os.path.join(SCENE, "masks"),
-                         "--ImageReader.single_camera_per_folder", "1",
-                         single_camera=False)
+        shutil.copy(EXTRACTED, database)
         return database
 
     def configure(self, database, config, *options, check=True):
