@@ -84,6 +84,15 @@ readonly FLAGS=(-std=c++17 -O1 -g -fno-omit-frame-pointer
                 -fno-sanitize-recover=undefined
                 -I "${REPO_ROOT}" -I "${BUILD_DIR}/colmap-src/src"
                 -I /usr/include/eigen3)
+# clang++ through ccache when there is one, with the settings of
+# scripts/build.sh (the cache outside the clone, paths relative to it).
+COMPILER=(clang++)
+if command -v ccache >/dev/null 2>&1; then
+  COMPILER=(ccache clang++)
+  export CCACHE_BASEDIR="${REPO_ROOT}"
+  export CCACHE_DIR="${CCACHE_DIR:-${HOME}/.cache/ccache}"
+  export CCACHE_NOHASHDIR=true
+fi
 # The flags and libraries of the colmap program as build.ninja has them.
 ninja_field() {  # ninja_field BUILD_LINE_PATTERN FIELD
   awk -v pattern="$1" -v field="$2" '
@@ -92,37 +101,39 @@ ninja_field() {  # ninja_field BUILD_LINE_PATTERN FIELD
     "${BUILD_DIR}/build.ninja"
 }
 build_target() {
-  local target="$1" sources=()
+  local target="$1" cflags=() sources=() libraries=()
   local scene="${BUILD_DIR}/colmap-src/src/colmap/scene"
   case "${target}" in
     fuzz_image_bytes)
       sources=("${REPO_ROOT}/colmap_ext/image/image_file_structure.cc") ;;
     fuzz_calibration_import|fuzz_camera_presets)
       # shellcheck disable=SC2207
-      sources=($(ls "${REPO_ROOT}"/calibration/*.cc | grep -v _test.cc)
-               -I /usr/include/opencv4 -lopencv_core -lyaml-cpp -lceres -lglog) ;;
+      sources=($(ls "${REPO_ROOT}"/calibration/*.cc | grep -v _test.cc))
+      cflags=(-I /usr/include/opencv4)
+      libraries=(-lopencv_core -lyaml-cpp -lceres -lglog) ;;
     fuzz_database_check|fuzz_camera_params|fuzz_model_readers|fuzz_rig_config)
       # The sources under test instrumented, the rest of COLMAP linked from
       # the build with the flags of one of its objects.
       local object="build colmap/src/colmap/scene/CMakeFiles/colmap_scene.dir/reconstruction_io_binary.cc.o:"
       local program="build colmap/src/colmap/exe/colmap: "
-      local own=("${scene}/reconstruction_io_binary.cc"
-                 "${scene}/reconstruction_io_text.cc")
-      [ "${target}" = fuzz_rig_config ] && own=("${scene}/rig.cc")
-      [ "${target}" = fuzz_database_check ] && own=(
+      sources=("${scene}/reconstruction_io_binary.cc"
+               "${scene}/reconstruction_io_text.cc")
+      [ "${target}" = fuzz_rig_config ] && sources=("${scene}/rig.cc")
+      [ "${target}" = fuzz_database_check ] && sources=(
           "${REPO_ROOT}/colmap_ext/scene/database_check.cc"
           "${REPO_ROOT}/colmap_ext/scene/camera_params_error.cc")
-      [ "${target}" = fuzz_camera_params ] && own=(
+      [ "${target}" = fuzz_camera_params ] && sources=(
           "${REPO_ROOT}/colmap_ext/controllers/image_errors.cc"
           "${REPO_ROOT}/colmap_ext/scene/camera_params_error.cc"
           "${REPO_ROOT}/colmap_ext/image/image_file_structure.cc")
       # shellcheck disable=SC2207
-      sources=($(ninja_field "${object}" DEFINES) $(ninja_field "${object}" INCLUDES)
-               "${own[@]}" $(ninja_field "${program}" LINK_LIBRARIES) -fopenmp) ;;
+      cflags=($(ninja_field "${object}" DEFINES) $(ninja_field "${object}" INCLUDES))
+      # shellcheck disable=SC2207
+      libraries=($(ninja_field "${program}" LINK_LIBRARIES) -fopenmp) ;;
     *) echo "fuzz.sh: unknown target ${target}" >&2; exit 2 ;;
   esac
   local binary="${WORK}/${target}"
-  local inputs=("${REPO_ROOT}/tests/fuzz/${target}.cc" "${sources[@]}")
+  sources=("${REPO_ROOT}/tests/fuzz/${target}.cc" "${sources[@]}")
   # Rebuilt when a source is newer than the binary.
   local newest
   newest="$(ls -t "${REPO_ROOT}/tests/fuzz/${target}.cc" \
@@ -132,8 +143,20 @@ build_target() {
             "$(readlink -f "${COLMAP}")" "${binary}" 2>/dev/null | head -1 || true)"
   if [ ! -x "${binary}" ] || [ "${newest}" != "${binary}" ]; then
     log "building ${target}"
-    # In the build folder: the libraries of build.ninja are relative to it.
-    (cd "${BUILD_DIR}" && clang++ "${FLAGS[@]}" "${inputs[@]}" -o "${binary}.tmp")
+    # One object per source through ccache (the instrumented COLMAP and
+    # calibration sources are most of a fresh clone's fuzz.short: with a
+    # warm ccache they are hits), then the link. In the build folder: the
+    # libraries of build.ninja are relative to it.
+    local objects=() source object
+    mkdir -p "${WORK}/objects/${target}"
+    for source in "${sources[@]}"; do
+      object="${WORK}/objects/${target}/$(basename "${source}").o"
+      (cd "${BUILD_DIR}" && "${COMPILER[@]}" "${FLAGS[@]}" "${cflags[@]}" \
+         -c "${source}" -o "${object}")
+      objects+=("${object}")
+    done
+    (cd "${BUILD_DIR}" && clang++ "${FLAGS[@]}" "${objects[@]}" \
+       ${libraries[@]+"${libraries[@]}"} -o "${binary}.tmp")
     mv "${binary}.tmp" "${binary}"
   fi
 }
