@@ -9,7 +9,9 @@ set(SPHERA_COLMAP_CONTROLLER_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/image/dual_fisheye_split.cc
   ${CMAKE_CURRENT_LIST_DIR}/image/image_file_structure.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/mapper_report.cc
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/matching_status.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/model_evaluation.cc
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/option_values.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/rig_calibration.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/rig_direction_check.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_bundle_adjustment.cc
@@ -22,7 +24,10 @@ set(SPHERA_COLMAP_CONTROLLER_SRCS
 set(SPHERA_COLMAP_SCENE_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/scene/camera_params_error.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/database_check.cc
-  ${CMAKE_CURRENT_LIST_DIR}/scene/intrinsics_divergence.cc)
+  ${CMAKE_CURRENT_LIST_DIR}/scene/intrinsics_divergence.cc
+  ${CMAKE_CURRENT_LIST_DIR}/scene/points_at_camera_center.cc
+  ${CMAKE_CURRENT_LIST_DIR}/scene/rig_config.cc
+  ${CMAKE_CURRENT_LIST_DIR}/scene/unused_cameras.cc)
 set(SPHERA_COLMAP_CONTROLLER_LIBS
   $<BUILD_INTERFACE:sphera_calibration>
   $<BUILD_INTERFACE:sphera_estimators>

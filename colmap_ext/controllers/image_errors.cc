@@ -2,6 +2,7 @@
 
 #include "colmap/scene/camera.h"
 #include "colmap/sensor/models.h"
+#include "colmap/util/logging.h"
 #include "colmap/util/string.h"
 #include "colmap_ext/image/image_file_structure.h"
 #include "colmap_ext/scene/camera_params_error.h"
@@ -71,9 +72,38 @@ void ReportImageError(const std::string& image_name,
   Errors().push_back(prefix + message);
 }
 
-std::vector<std::string> ImageErrors() {
+void ReportImageReaderStatus(const std::string& image_name,
+                             const ImageReader::Status status) {
+  // An image already in the database is not an error, nor a file of no
+  // image type in the image folder (a README).
+  if (status != ImageReader::Status::SUCCESS &&
+      status != ImageReader::Status::IMAGE_EXISTS &&
+      (status != ImageReader::Status::BITMAP_ERROR ||
+       HasImageFileExtension(image_name))) {
+    ReportImageError(image_name, ImageReader::StatusToString(status));
+  }
+}
+
+std::string TooSmallImageError(const int width, const int height) {
+  constexpr int kMinImageSize = 16;
+  if (width < kMinImageSize || height < kMinImageSize) {
+    return StringPrintf(
+        "%dx%d pixels: too small to extract features from", width, height);
+  }
+  return "";
+}
+
+int ImageErrorsExitStatus() {
   std::lock_guard<std::mutex> lock(ErrorsMutex());
-  return Errors();
+  if (Errors().empty()) {
+    return EXIT_SUCCESS;
+  }
+  LOG(ERROR) << Errors().size()
+             << " image(s) could not be processed (the others were):";
+  for (const std::string& image_error : Errors()) {
+    LOG(ERROR) << "  " << image_error;
+  }
+  return EXIT_FAILURE;
 }
 
 void ClearImageErrors() {

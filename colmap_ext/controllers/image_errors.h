@@ -3,6 +3,8 @@
 // extracted, and the command exits non-zero.
 #pragma once
 
+#include "colmap/controllers/image_reader.h"
+
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -21,9 +23,21 @@ std::string ImageReaderCameraOptionsError(const std::string& camera_model,
 // image only.
 void ReportImageError(const std::string& image_name, const std::string& message);
 
-std::vector<std::string> ImageErrors();
-
 void ClearImageErrors();
+
+// Reports the image as one that could not be processed when the reader's
+// `status` says so: not for an image already in the database, nor for a
+// file without an image file extension (HasImageFileExtension).
+void ReportImageReaderStatus(const std::string& image_name,
+                             ImageReader::Status status);
+
+// "WxH pixels: too small to extract features from" for an image narrower
+// or lower than 16 pixels, else empty.
+std::string TooSmallImageError(int width, int height);
+
+// EXIT_SUCCESS when no image error was reported since ClearImageErrors();
+// otherwise logs them and returns EXIT_FAILURE.
+int ImageErrorsExitStatus();
 
 // True for the file extensions of image formats COLMAP reads (case
 // insensitive). A file without one in an image folder (a README, a .txt) is

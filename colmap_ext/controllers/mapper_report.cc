@@ -80,7 +80,8 @@ std::vector<MapperImageReport> BuildMapperReport(
 }
 
 void LogMapperReport(const std::vector<MapperImageReport>& report,
-                     const ReconstructionManager& reconstruction_manager) {
+                     const ReconstructionManager& reconstruction_manager,
+                     const std::vector<HeldCamera>& held_cameras) {
   size_t num_registered = 0;
   for (const MapperImageReport& entry : report) {
     if (entry.model_index >= 0) ++num_registered;
@@ -104,7 +105,7 @@ void LogMapperReport(const std::vector<MapperImageReport>& report,
       LOG(WARNING) << entry.name << ": not registered: " << entry.reason;
     }
   }
-  for (const HeldCamera& held : TakeHeldCameras()) {
+  for (const HeldCamera& held : held_cameras) {
     LOG(WARNING) << "Camera " << held.camera.camera_id << " ("
                  << held.camera.ModelName()
                  << ") was held: its self-calibration ran away (" << held.reason

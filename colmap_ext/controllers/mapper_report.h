@@ -10,6 +10,7 @@
 
 #include "colmap/scene/database.h"
 #include "colmap/scene/reconstruction_manager.h"
+#include "colmap_ext/scene/intrinsics_divergence.h"
 
 namespace colmap {
 
@@ -37,8 +38,10 @@ std::vector<MapperImageReport> BuildMapperReport(
     const std::vector<std::string>& image_names);
 
 // Logs the models (images and points each) and every image that is in no
-// model, with its reason; a split into several models is pointed out.
+// model, with its reason; a split into several models is pointed out, and
+// the cameras the mapper held (IncrementalPipeline::HeldCameras) are named.
 void LogMapperReport(const std::vector<MapperImageReport>& report,
-                     const ReconstructionManager& reconstruction_manager);
+                     const ReconstructionManager& reconstruction_manager,
+                     const std::vector<HeldCamera>& held_cameras);
 
 }  // namespace colmap

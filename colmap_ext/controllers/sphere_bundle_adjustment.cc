@@ -659,6 +659,9 @@ bool SphereBundleAdjust(const SphereBundleAdjustmentOptions& options,
 
 void RunCameraOnlyRefinement(const double tau_px,
                              Reconstruction* reconstruction) {
+  if (tau_px <= 0) {
+    return;
+  }
   SphereBundleAdjustmentOptions options;
   options.mode = SphereBundleAdjustmentOptions::Mode::CAMERA_ONLY;
   options.tau_px = tau_px;

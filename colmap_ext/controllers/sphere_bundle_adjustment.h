@@ -109,7 +109,8 @@ bool SphereBundleAdjust(const SphereBundleAdjustmentOptions& options,
 // The mapper's option camera_only_ba_tau_px: camera-only adjustment of a
 // finished reconstruction in place, with a log line of what it did; on
 // failure (e.g. tau below the noise floor) the reconstruction is kept as it
-// was and a warning names the reason.
+// was and a warning names the reason. Nothing when tau_px is not positive
+// (the option's default, 0).
 void RunCameraOnlyRefinement(double tau_px, Reconstruction* reconstruction);
 
 }  // namespace colmap

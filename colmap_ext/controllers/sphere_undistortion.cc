@@ -936,4 +936,28 @@ std::string MissingImageFiles(const Reconstruction& reconstruction,
   return message.str();
 }
 
+std::string ImageUndistorterInputError(
+    const Reconstruction& reconstruction,
+    const std::vector<image_t>& image_ids,
+    const std::filesystem::path& input_path,
+    const std::filesystem::path& image_list_path,
+    const std::string& image_path) {
+  if (reconstruction.NumRegImages() == 0) {
+    return "no view to write: the reconstruction at " + input_path.string() +
+           " has no registered image";
+  }
+  if (!image_list_path.empty() && image_ids.empty()) {
+    return "no view to write: no image of " + image_list_path.string() +
+           " is in the reconstruction";
+  }
+  const std::string missing = MissingImageFiles(
+      reconstruction,
+      image_ids.empty() ? reconstruction.RegImageIds() : image_ids,
+      image_path);
+  if (!missing.empty()) {
+    return missing + " (--image_list_path selects images)";
+  }
+  return "";
+}
+
 }  // namespace colmap

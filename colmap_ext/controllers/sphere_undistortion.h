@@ -25,6 +25,7 @@
 #include "colmap/scene/reconstruction.h"
 
 #include <cstddef>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -214,5 +215,16 @@ SphereExportSummary ExportPerspectiveWorkspace(
 std::string MissingImageFiles(const Reconstruction& reconstruction,
                               const std::vector<image_t>& image_ids,
                               const std::string& image_path);
+
+// Empty, or why image_undistorter would write a workspace without a view:
+// the reconstruction at `input_path` has no registered image, none of the
+// images of `image_list_path` (when given; `image_ids` are those found) is
+// in it, or an image file of the views is missing (MissingImageFiles).
+std::string ImageUndistorterInputError(
+    const Reconstruction& reconstruction,
+    const std::vector<image_t>& image_ids,
+    const std::filesystem::path& input_path,
+    const std::filesystem::path& image_list_path,
+    const std::string& image_path);
 
 }  // namespace colmap

@@ -7,10 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <set>
@@ -542,14 +540,6 @@ class DatabaseChecker {
   std::unordered_map<int64_t, int64_t> num_keypoints_;
 };
 
-// False for a file that does not exist or is empty: a database COLMAP is
-// about to create.
-bool HoldsDatabase(const std::filesystem::path& path) {
-  std::error_code error;
-  return std::filesystem::exists(path, error) &&
-         std::filesystem::file_size(path, error) > 0 && !error;
-}
-
 // ": camera C (MODEL) lifts only P% of its image to rays, ..." for the
 // cameras of images whose parameters turn fewer than half of a grid of
 // pixels into viewing rays (an image circle or field of view far from the
@@ -600,154 +590,10 @@ std::string CamerasLiftingLittle(const ReadOnlyDatabase& db) {
 
 }  // namespace
 
-std::string MissingDatabaseError(const std::string& command, int argc,
-                                 const char* const* argv) {
-  static const std::set<std::string> kCreating = {
-      "feature_extractor", "feature_importer", "database_creator",
-      "automatic_reconstructor", "gui"};
-  if (kCreating.count(command)) {
-    return "";
-  }
-  // The value of `--NAME VALUE` or `--NAME=VALUE`.
-  const auto values_of = [&](const std::string& name) {
-    const std::string option = "--" + name;
-    std::vector<std::string> values;
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      if (arg == option && i + 1 < argc) {
-        values.push_back(argv[i + 1]);
-      } else if (arg.rfind(option + "=", 0) == 0) {
-        values.push_back(arg.substr(option.size() + 1));
-      }
-    }
-    return values;
-  };
-  std::vector<std::string> paths = values_of("database_path");
-  // A project file (--project_path) names its database in a line
-  // `database_path=PATH`.
-  for (const std::string& project : values_of("project_path")) {
-    std::ifstream file(project);
-    std::string line;
-    while (std::getline(file, line)) {
-      const std::string key = "database_path=";
-      const size_t start = line.find_first_not_of(" \t");
-      if (start != std::string::npos &&
-          line.compare(start, key.size(), key) == 0) {
-        std::string path = line.substr(start + key.size());
-        path.erase(path.find_last_not_of(" \t\r") + 1);
-        paths.push_back(path);
-      }
-    }
-  }
-  for (const std::string& path : paths) {
-    std::error_code error;
-    if (!std::filesystem::exists(path, error)) {
-      return "database " + path +
-             " does not exist (feature_extractor creates a database)";
-    }
-    if (std::filesystem::is_regular_file(path, error) &&
-        std::filesystem::file_size(path, error) == 0) {
-      return "database " + path +
-             " is empty (feature_extractor fills a database)";
-    }
-  }
-  return "";
-}
-
-int RemoveUnusedCameras(const std::filesystem::path& path,
-                        const int64_t keep_camera_id) {
-  if (!HoldsDatabase(path)) {
-    return 0;
-  }
-  sqlite3* db = nullptr;
-  const auto fail = [&](const std::string& what) {
-    const std::string message = db ? sqlite3_errmsg(db) : "out of memory";
-    sqlite3_close_v2(db);
-    throw std::runtime_error("database " + path.string() + ": " + what +
-                             ": " + message);
-  };
-  if (sqlite3_open_v2(path.string().c_str(), &db, SQLITE_OPEN_READWRITE,
-                      nullptr) != SQLITE_OK) {
-    fail("cannot be opened");
-  }
-  const auto count = [](void* n, int, char** values, char**) {
-    *static_cast<int*>(n) = std::atoi(values[0]);
-    return 0;
-  };
-  int tables = 0;
-  sqlite3_exec(db,
-               "SELECT count(*) FROM sqlite_master WHERE type = 'table' AND "
-               "name IN ('cameras', 'images', 'rigs', 'rig_sensors', 'frames');",
-               count, &tables, nullptr);
-  if (tables != 5) {  // not (yet) a database of COLMAP 4's rigs and frames
-    sqlite3_close_v2(db);
-    return 0;
-  }
-  const std::string camera = std::to_string(kCameraSensor);
-  const std::string unused =
-      "SELECT camera_id FROM cameras WHERE camera_id != " +
-      std::to_string(keep_camera_id) +
-      " AND camera_id NOT IN (SELECT camera_id FROM images)"
-      " AND camera_id NOT IN (SELECT sensor_id FROM rig_sensors"
-      "   WHERE sensor_type = " + camera + ")"
-      " AND camera_id NOT IN (SELECT ref_sensor_id FROM rigs"
-      "   WHERE ref_sensor_type = " + camera +
-      "   AND (rig_id IN (SELECT rig_id FROM frames)"
-      "     OR rig_id IN (SELECT rig_id FROM rig_sensors)))";
-  int removed = 0;
-  const std::string sql =
-      "BEGIN IMMEDIATE;"
-      "CREATE TEMP TABLE sphera_unused AS " + unused + ";"
-      "SELECT count(*) FROM sphera_unused;"
-      "DELETE FROM rigs WHERE ref_sensor_type = " + camera +
-      "  AND ref_sensor_id IN (SELECT camera_id FROM sphera_unused);"
-      "DELETE FROM cameras WHERE camera_id IN"
-      "  (SELECT camera_id FROM sphera_unused);"
-      "DROP TABLE sphera_unused;"
-      "COMMIT;";
-  if (sqlite3_exec(db, sql.c_str(), count, &removed, nullptr) != SQLITE_OK) {
-    sqlite3_exec(db, "ROLLBACK;", nullptr, nullptr, nullptr);
-    fail("cannot remove the cameras no image uses");
-  }
-  sqlite3_close_v2(db);
-  return removed;
-}
-
-std::string MissingPaths(const std::string& command, int argc,
-                         const char* const* argv) {
-  static const std::set<std::string> kCommandsCreatingOutput = {
-      "dual_fisheye_splitter", "image_undistorter", "rig_preset",
-      "sphere_bundle_adjuster", "sphere_undistorter"};
-  const bool creates_output = kCommandsCreatingOutput.count(command) > 0;
-  std::string missing;
-  for (int i = 1; i < argc; ++i) {
-    std::string option = argv[i];
-    std::string value;
-    const size_t equals = option.find('=');
-    if (equals != std::string::npos) {
-      value = option.substr(equals + 1);
-      option = option.substr(0, equals);
-    } else if (i + 1 < argc) {
-      value = argv[i + 1];
-    }
-    const size_t suffix = option.rfind("_path");
-    std::error_code error;
-    if (option.rfind("--", 0) != 0 || suffix == std::string::npos ||
-        suffix + 5 != option.size() || value.empty() ||
-        std::filesystem::exists(value, error)) {
-      continue;
-    }
-    // An output path in an existing folder is one the command would create.
-    if (creates_output && option.size() >= 13 &&
-        option.compare(option.size() - 11, 11, "output_path") == 0 &&
-        std::filesystem::is_directory(
-            std::filesystem::absolute(value, error).parent_path(), error)) {
-      continue;
-    }
-    missing += (missing.empty() ? "paths that do not exist: " : ", ") +
-               option + " " + value;
-  }
-  return missing;
+bool HoldsDatabase(const std::filesystem::path& path) {
+  std::error_code error;
+  return std::filesystem::exists(path, error) &&
+         std::filesystem::file_size(path, error) > 0 && !error;
 }
 
 std::string NoVerifiedPairError(const std::filesystem::path& path,
@@ -811,6 +657,18 @@ std::string NoVerifiedPairError(const std::filesystem::path& path,
   return name + "no image pair passed geometric verification: of " +
          Str(num_pairs) + " pairs matched, " + why +
          " A mapper has nothing to start from; the matches are kept.";
+}
+
+std::string MatchOfMissingKeypointError(const uint32_t image_id1,
+                                        const uint32_t image_id2,
+                                        const uint32_t image_id,
+                                        const uint32_t point2D_idx,
+                                        const size_t num_keypoints) {
+  return "the verified matches of images " + Str(image_id1) + " and " +
+         Str(image_id2) + " refer to keypoint " + Str(point2D_idx) +
+         " of image " + Str(image_id) + ", which has " + Str(num_keypoints) +
+         " keypoints: the database's matches do not belong to its keypoints "
+         "(match the images again)";
 }
 
 void CheckDatabaseFile(const std::filesystem::path& path,

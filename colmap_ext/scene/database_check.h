@@ -1,6 +1,8 @@
-// A check of a COLMAP database file before COLMAP opens it for writing.
+// Read-only checks of a COLMAP database file: before COLMAP opens it for
+// writing, and after a matching run.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -26,26 +28,9 @@ namespace colmap {
 // new database) passes.
 void CheckDatabaseFile(const std::filesystem::path& path, int format_version);
 
-// Empty, or why `colmap COMMAND ARGS` cannot run: its --database_path (or
-// the database_path of its --project_path file) names a file that does not
-// exist or is empty, and the command only reads and
-// adds to a database (every command but feature_extractor,
-// feature_importer, database_creator, automatic_reconstructor and gui,
-// which create one). COLMAP would create an empty database there and then
-// fail, leaving the new file behind.
-std::string MissingDatabaseError(const std::string& command, int argc,
-                                 const char* const* argv);
-
-// Removes from the database at `path` (if it exists), in one transaction,
-// the cameras that no image uses, together with the rigs of which such a
-// camera is the only sensor and that no frame uses: what a feature
-// extraction killed midway leaves (it writes an image's camera and rig
-// before the image). `keep_camera_id` (--ImageReader.existing_camera_id,
-// a camera made beforehand for the images to come) is kept. Returns the
-// number of cameras removed; throws like CheckDatabaseFile when the file
-// cannot be changed.
-int RemoveUnusedCameras(const std::filesystem::path& path,
-                        int64_t keep_camera_id);
+// False for a file that does not exist or is empty: a database COLMAP is
+// about to create.
+bool HoldsDatabase(const std::filesystem::path& path);
 
 // Empty, or why the matching that just wrote to the database at `path`
 // leaves it with no image pair a mapper can use (no two-view geometry
@@ -56,15 +41,14 @@ int RemoveUnusedCameras(const std::filesystem::path& path,
 std::string NoVerifiedPairError(const std::filesystem::path& path,
                                 int min_num_inliers);
 
-// Empty, or "paths that do not exist: --OPTION PATH, ..." for the options
-// of ARGS named *_path whose value is not in the file system (said after
-// `colmap COMMAND ARGS` failed, whichever path made it fail). An
-// *output_path in an existing folder is not missing for the commands that
-// create their output (dual_fisheye_splitter, image_undistorter,
-// rig_preset, sphere_bundle_adjuster, sphere_undistorter); the others, such
-// as mapper,
-// need it to exist.
-std::string MissingPaths(const std::string& command, int argc,
-                         const char* const* argv);
+// "the verified matches of images ID1 and ID2 refer to keypoint POINT2D_IDX
+// of image IMAGE_ID, which has NUM_KEYPOINTS keypoints: ..." (the database's
+// matches belong to other keypoints: damaged, or features extracted again
+// after matching; using the others would build on garbage).
+std::string MatchOfMissingKeypointError(uint32_t image_id1,
+                                        uint32_t image_id2,
+                                        uint32_t image_id,
+                                        uint32_t point2D_idx,
+                                        size_t num_keypoints);
 
 }  // namespace colmap

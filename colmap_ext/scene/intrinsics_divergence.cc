@@ -1,8 +1,9 @@
 #include "colmap_ext/scene/intrinsics_divergence.h"
 
+#include "colmap/util/logging.h"
+
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <sstream>
 
 namespace colmap {
@@ -62,30 +63,34 @@ std::string IntrinsicsDivergence(const Camera& prior,
   return "";
 }
 
-namespace {
-
-std::mutex& HeldCamerasMutex() {
-  static std::mutex mutex;
-  return mutex;
+void DivergedCameraHold::Remember(const Reconstruction& reconstruction) {
+  params_before_.clear();
+  for (const auto& [camera_id, camera] : reconstruction.Cameras()) {
+    params_before_.emplace(camera_id, camera.params);
+  }
 }
 
-std::vector<HeldCamera>& HeldCameraList() {
-  static std::vector<HeldCamera> held;
-  return held;
-}
-
-}  // namespace
-
-void RecordHeldCamera(const Camera& camera, const std::string& reason) {
-  const std::lock_guard<std::mutex> lock(HeldCamerasMutex());
-  HeldCameraList().push_back({camera, reason});
-}
-
-std::vector<HeldCamera> TakeHeldCameras() {
-  const std::lock_guard<std::mutex> lock(HeldCamerasMutex());
-  std::vector<HeldCamera> held;
-  held.swap(HeldCameraList());
-  return held;
+void DivergedCameraHold::HoldDiverged(const DatabaseCache& database_cache,
+                               const IntrinsicsDivergenceOptions& options,
+                               Reconstruction* reconstruction) {
+  for (const auto& [camera_id, before] : params_before_) {
+    if (held_ids_.count(camera_id) || !database_cache.ExistsCamera(camera_id)) {
+      continue;
+    }
+    Camera& camera = reconstruction->Camera(camera_id);
+    const std::string why =
+        IntrinsicsDivergence(database_cache.Camera(camera_id), camera, options);
+    if (why.empty()) {
+      continue;
+    }
+    camera.params = before;
+    LOG(WARNING) << "Camera " << camera_id << " (" << camera.ModelName()
+                 << "): its self-calibration ran away: " << why
+                 << ". Held at its value before this bundle adjustment ("
+                 << camera.ParamsToString() << ") and no longer refined.";
+    held_ids_.insert(camera_id);
+    held_.push_back({camera, why});
+  }
 }
 
 }  // namespace colmap

@@ -6,8 +6,12 @@
 #pragma once
 
 #include "colmap/scene/camera.h"
+#include "colmap/scene/database_cache.h"
+#include "colmap/scene/reconstruction.h"
 
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace colmap {
@@ -30,14 +34,36 @@ std::string IntrinsicsDivergence(
     const Camera& refined,
     const IntrinsicsDivergenceOptions& options = IntrinsicsDivergenceOptions());
 
-// The cameras the mappers of this process held since the last
-// TakeHeldCameras(), in the order they were held, for the mapper's closing
-// report: the camera as held (id, model, params) and why. Thread-safe.
+// A camera the mapper held, as held (id, model, params), and why.
 struct HeldCamera {
   Camera camera;
   std::string reason;
 };
-void RecordHeldCamera(const Camera& camera, const std::string& reason);
-std::vector<HeldCamera> TakeHeldCameras();
+
+// The cameras one incremental mapper holds: around each bundle adjustment,
+// Remember() the cameras' parameters before it, and HoldDiverged() after it.
+class DivergedCameraHold {
+ public:
+  // Remembers the parameters of every camera of `reconstruction`.
+  void Remember(const Reconstruction& reconstruction);
+
+  // Each camera of `reconstruction` that is not held yet, that
+  // `database_cache` has (its prior) and whose parameters now diverge from
+  // the prior's (IntrinsicsDivergence) is set back to the parameters
+  // Remember() saw, held (no longer to be refined) and named in a warning.
+  void HoldDiverged(const DatabaseCache& database_cache,
+                    const IntrinsicsDivergenceOptions& options,
+                    Reconstruction* reconstruction);
+
+  bool IsHeld(camera_t camera_id) const { return held_ids_.count(camera_id); }
+  const std::unordered_set<camera_t>& Ids() const { return held_ids_; }
+  // In the order they were held.
+  const std::vector<HeldCamera>& Held() const { return held_; }
+
+ private:
+  std::unordered_map<camera_t, std::vector<double>> params_before_;
+  std::unordered_set<camera_t> held_ids_;
+  std::vector<HeldCamera> held_;
+};
 
 }  // namespace colmap

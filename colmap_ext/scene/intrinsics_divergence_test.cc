@@ -67,5 +67,38 @@ TEST(IntrinsicsDivergence, RunawaysAreNamed) {
   EXPECT_FALSE(why.empty());
 }
 
+TEST(DivergedCameraHold, SetsBackHoldsAndNamesARunaway) {
+  const Camera prior = MakeCamera("EUCM", {280, 280, 512, 512, 0.6, 1.0});
+  DatabaseCache database_cache;
+  database_cache.AddCamera(prior);
+  Camera unknown = prior;
+  unknown.camera_id = 2;
+  Reconstruction reconstruction;
+  reconstruction.AddCamera(prior);
+  reconstruction.AddCamera(unknown);
+
+  DivergedCameraHold hold;
+  hold.Remember(reconstruction);
+  reconstruction.Camera(1).params[0] = 97205;
+  reconstruction.Camera(2).params[0] = 97205;
+  hold.HoldDiverged(database_cache, IntrinsicsDivergenceOptions(),
+                    &reconstruction);
+  EXPECT_TRUE(hold.IsHeld(1));
+  // A camera without a prior is not judged.
+  EXPECT_FALSE(hold.IsHeld(2));
+  EXPECT_EQ(reconstruction.Camera(1).params, prior.params);
+  ASSERT_EQ(hold.Held().size(), 1);
+  EXPECT_EQ(hold.Held()[0].camera.params, prior.params);
+  EXPECT_NE(hold.Held()[0].reason.find("focal length"), std::string::npos);
+
+  // A held camera is not set back again.
+  hold.Remember(reconstruction);
+  reconstruction.Camera(1).params[0] = 5000;
+  hold.HoldDiverged(database_cache, IntrinsicsDivergenceOptions(),
+                    &reconstruction);
+  EXPECT_EQ(reconstruction.Camera(1).params[0], 5000);
+  EXPECT_EQ(hold.Held().size(), 1);
+}
+
 }  // namespace
 }  // namespace colmap

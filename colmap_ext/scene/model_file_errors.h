@@ -3,6 +3,8 @@
 #pragma once
 
 #include "colmap/scene/reconstruction.h"
+#include "colmap/scene/reconstruction_io_binary.h"
+#include "colmap/scene/reconstruction_io_text.h"
 #include "colmap_ext/util/file_output.h"
 
 #include <algorithm>
@@ -139,6 +141,89 @@ inline void CheckPoint3DReferences(const Reconstruction& reconstruction) {
       "the tracks hold " + std::to_string(num_observations) +
       " observations but the images refer to points " +
       std::to_string(num_references) + " times (a repeated track entry)");
+}
+
+// ReadModelFile, then CheckFiniteValues: for the binary files, which hold
+// values as they are.
+template <typename Read>
+void ReadFiniteModelFile(const std::filesystem::path& path,
+                         const Reconstruction& reconstruction,
+                         Read&& read) {
+  ReadModelFile(path, [&] {
+    read();
+    CheckFiniteValues(reconstruction);
+  });
+}
+
+// Throws when the pose an image record of images.bin holds is not finite:
+// unused when frames.bin holds the poses, but a damaged file all the same.
+inline void CheckFinitePose(image_t image_id, const Rigid3d& cam_from_world) {
+  if (!cam_from_world.rotation().coeffs().allFinite() ||
+      !cam_from_world.translation().allFinite()) {
+    throw std::runtime_error("image " + std::to_string(image_id) +
+                             ": its pose is not finite");
+  }
+}
+
+// The frame of `image_id` in the map of images to frames that frames.bin
+// gives; throws when the image is in none.
+template <typename ImageToFrame>
+auto* FrameOfImage(const ImageToFrame& image_to_frame, image_t image_id) {
+  const auto frame_it = image_to_frame.find(image_id);
+  if (frame_it == image_to_frame.end()) {
+    throw std::runtime_error("image " + std::to_string(image_id) +
+                             " is in no frame of frames.bin");
+  }
+  return frame_it->second;
+}
+
+// Reads the rest of a line of points3D.txt, the track of point
+// `point3D_id`: pairs IMAGE_ID POINT2D_IDX. Throws unless it is a list of
+// such pairs.
+inline void ReadTrackText(std::istream& line_stream,
+                          point3D_t point3D_id,
+                          Track* track) {
+  std::vector<uint64_t> track_values;
+  uint64_t value;
+  while (line_stream >> value) {
+    track_values.push_back(value);
+  }
+  if (!line_stream.eof() || track_values.size() % 2 != 0) {
+    throw std::runtime_error(
+        "point " + std::to_string(point3D_id) +
+        ": the track is not a list of (IMAGE_ID, POINT2D_IDX) pairs");
+  }
+  for (size_t i = 0; i < track_values.size(); i += 2) {
+    track->AddElement(static_cast<image_t>(track_values[i]),
+                      static_cast<point2D_t>(track_values[i + 1]));
+  }
+}
+
+// Writes the model files of `reconstruction` into the folder `path`, text
+// or binary, under temporary names renamed into place once all are
+// complete (WriteFilesAtomically).
+inline void WriteModelFiles(const Reconstruction& reconstruction,
+                            const std::filesystem::path& path,
+                            bool binary) {
+  using P = const std::filesystem::path&;
+  const Reconstruction& r = reconstruction;
+  if (binary) {
+    WriteFilesAtomically(
+        path,
+        {{"rigs.bin", [&r](P p) { WriteRigsBinary(r, p); }},
+         {"cameras.bin", [&r](P p) { WriteCamerasBinary(r, p); }},
+         {"frames.bin", [&r](P p) { WriteFramesBinary(r, p); }},
+         {"images.bin", [&r](P p) { WriteImagesBinary(r, p); }},
+         {"points3D.bin", [&r](P p) { WritePoints3DBinary(r, p); }}});
+  } else {
+    WriteFilesAtomically(
+        path,
+        {{"rigs.txt", [&r](P p) { WriteRigsText(r, p); }},
+         {"cameras.txt", [&r](P p) { WriteCamerasText(r, p); }},
+         {"frames.txt", [&r](P p) { WriteFramesText(r, p); }},
+         {"images.txt", [&r](P p) { WriteImagesText(r, p); }},
+         {"points3D.txt", [&r](P p) { WritePoints3DText(r, p); }}});
+  }
 }
 
 }  // namespace colmap
