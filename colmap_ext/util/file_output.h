@@ -21,13 +21,17 @@
 namespace colmap {
 
 // The one way SPHERA's commands write their results: every file or folder is
-// first written under a temporary name beside its final one ("NAME.tmp-PID"),
+// first written under a temporary name beside its final one ("NAME.tmp-PID"
+// by default),
 // and only Commit() gives them their names, so that a failed or killed run
 // leaves what was there. Destroyed before Commit(), it removes what it wrote
 // and the folders it created (when they are empty).
 class StagedOutput {
  public:
-  StagedOutput() = default;
+  // Temporary names are final names + `suffix` (default ".tmp-PID").
+  explicit StagedOutput(std::string suffix = "")
+      : suffix_(suffix.empty() ? ".tmp-" + std::to_string(::getpid())
+                               : std::move(suffix)) {}
   StagedOutput(const StagedOutput&) = delete;
   StagedOutput& operator=(const StagedOutput&) = delete;
 
@@ -112,9 +116,9 @@ class StagedOutput {
     bool is_folder;
   };
 
-  static std::filesystem::path TemporaryPath(
-      const std::filesystem::path& path) {
-    return path.string() + ".tmp-" + std::to_string(::getpid());
+  std::filesystem::path TemporaryPath(
+      const std::filesystem::path& path) const {
+    return path.string() + suffix_;
   }
 
   void MoveEntries(const std::filesystem::path& from,
@@ -150,6 +154,7 @@ class StagedOutput {
     created_folders_.push_back(folder);
   }
 
+  std::string suffix_;
   std::vector<Entry> staged_;
   std::vector<std::filesystem::path> committed_paths_;
   std::vector<std::filesystem::path> created_folders_;
@@ -165,7 +170,9 @@ inline void WriteFilesAtomically(
     const std::vector<std::pair<
         std::string, std::function<void(const std::filesystem::path&)>>>&
         files) {
-  StagedOutput staged;
+  // A fixed temporary name per file: a killed write leaves at most one
+  // NAME.tmp beside each file, which the next write replaces.
+  StagedOutput staged(".tmp");
   for (const auto& [name, write] : files) {
     write(staged.Stage(folder / name, /*create_folders=*/false));
   }
