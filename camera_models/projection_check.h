@@ -21,6 +21,62 @@
 
 namespace sphera {
 
+namespace internal {
+
+// Where a camera's field ends on the segment from `inside` (a pixel with a
+// ray) to `outside` (one without): the last pixel with a ray, found by
+// bisection to the precision of doubles, its unit ray and the ray's angle
+// to the axis.
+struct FieldEnd {
+  Eigen::Vector2d pixel;
+  Eigen::Vector3d ray;
+  double angle;
+};
+
+inline FieldEnd FindFieldEnd(int model_id, const std::vector<double>& params,
+                             Eigen::Vector2d inside, Eigen::Vector2d outside) {
+  Eigen::Vector3d ray;
+  RayFromImage(model_id, params, inside, &ray);
+  for (int i = 0; i < 64; ++i) {
+    const Eigen::Vector2d middle = 0.5 * (inside + outside);
+    if (middle == inside || middle == outside) break;
+    Eigen::Vector3d middle_ray;
+    if (RayFromImage(model_id, params, middle, &middle_ray) &&
+        middle_ray.allFinite() && middle_ray.norm() > 0) {
+      inside = middle;
+      ray = middle_ray;
+    } else {
+      outside = middle;
+    }
+  }
+  ray.normalize();
+  return {inside, ray, std::acos(std::clamp(ray.z(), -1.0, 1.0))};
+}
+
+// Whether the model projects to a finite pixel a ray turned 0.01°, 0.1° or
+// 1° further from the axis than `ray` (in the plane of `ray` and the axis):
+// then the model's field goes on past `ray`.
+inline bool ProjectsBeyond(int model_id, const std::vector<double>& params,
+                           const Eigen::Vector3d& ray) {
+  const double angle = std::acos(std::clamp(ray.z(), -1.0, 1.0));
+  const double azimuth =
+      std::hypot(ray.x(), ray.y()) > 0 ? std::atan2(ray.y(), ray.x()) : 0.0;
+  for (const double turn_deg : {0.01, 0.1, 1.0}) {
+    const double beyond = angle + turn_deg * M_PI / 180;
+    if (beyond >= M_PI) break;
+    const Eigen::Vector3d turned(std::sin(beyond) * std::cos(azimuth),
+                                 std::sin(beyond) * std::sin(azimuth),
+                                 std::cos(beyond));
+    Eigen::Vector2d pixel;
+    if (ImageFromRay(model_id, params, turned, &pixel) && pixel.allFinite()) {
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace internal
+
 // "" or why the projection of `model_id` with `params` is not usable over
 // the width x height image. Pixels without a ray (outside a fisheye's image
 // circle) are allowed; an image in which no sampled pixel has a ray is not.
@@ -108,6 +164,8 @@ inline std::string ProjectionOverImageError(int model_id,
   if (model_id == static_cast<int>(ModelId::kEquirectangular)) return "";
   constexpr int kLines = 12;
   constexpr int kSteps = 100;
+  // How far from the axis pixel the field reaches on any line.
+  double field_reach = 0;
   for (int line = 0; line < kLines; ++line) {
     const double phi = 2 * M_PI * line / kLines;
     const Eigen::Vector2d direction(std::cos(phi), std::sin(phi));
@@ -121,6 +179,7 @@ inline std::string ProjectionOverImageError(int model_id,
       }
     }
     double previous = -1;
+    Eigen::Vector2d previous_pixel = origin;
     for (int step = 0; step <= kSteps; ++step) {
       const Eigen::Vector2d pixel = origin + direction * reach * step / kSteps;
       double angle;
@@ -129,22 +188,31 @@ inline std::string ProjectionOverImageError(int model_id,
         return error;
       }
       if (angle < 0) {
-        // A lens's field may end inside the image (a fisheye's circle), but
-        // not before 90° from the axis: a break before it is a distortion
-        // whose inverse gives up.
+        // A lens's field may end inside the image (a fisheye's circle). One
+        // that ends before 90° from the axis is the model's own domain when
+        // the model sees no ray beyond it (EUCM: r² <= 1 / (beta (2 alpha -
+        // 1))), and a distortion whose inverse gives up when the model
+        // still projects rays further out.
         if (previous >= 0 && previous < M_PI / 2) {
-          return name + ": the projection breaks off inside the " +
-                 std::to_string(width) + "x" + std::to_string(height) +
-                 " image: pixel " + at(pixel.x(), pixel.y()) +
-                 " has no ray, the pixel before it on the line from the axis "
-                 "sees " +
-                 internal::FormatFixed(previous * 180 / M_PI, 2) +
-                 "° from the axis (a distortion that cannot be inverted "
-                 "there)";
+          const internal::FieldEnd end =
+              internal::FindFieldEnd(model_id, params, previous_pixel, pixel);
+          field_reach = std::max(field_reach, (end.pixel - origin).norm());
+          if (end.angle < M_PI / 2 &&
+              internal::ProjectsBeyond(model_id, params, end.ray)) {
+            return name + ": the projection breaks off inside the " +
+                   std::to_string(width) + "x" + std::to_string(height) +
+                   " image: past pixel " + at(end.pixel.x(), end.pixel.y()) +
+                   ", " + internal::FormatFixed(end.angle * 180 / M_PI, 2) +
+                   "° from the axis, pixels have no ray though the model "
+                   "projects rays further out (a distortion that cannot be "
+                   "inverted there)";
+          }
         }
         previous = -1;
         continue;
       }
+      previous_pixel = pixel;
+      field_reach = std::max(field_reach, (pixel - origin).norm());
       if (angle < previous - 1e-9) {
         return name + ": the projection folds inside the " +
                std::to_string(width) + "x" + std::to_string(height) +
@@ -155,6 +223,12 @@ inline std::string ProjectionOverImageError(int model_id,
       }
       previous = angle;
     }
+  }
+  if (field_reach < 1) {
+    return name + ": the field of view covers less than a pixel around " +
+           at(origin.x(), origin.y()) + " of the " + std::to_string(width) +
+           "x" + std::to_string(height) +
+           " image (focal length or distortion far off?)";
   }
   return "";
 }

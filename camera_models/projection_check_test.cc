@@ -34,6 +34,17 @@ TEST(ProjectionCheck, AcceptsUsableCameras) {
                 64, {900, 900, 800, 800, 1.6, -0.05, 0.01, 1e-4, -1e-4},
                 1600, 1600),
             "");
+  // Lenses whose field ends where the model's domain ends, before 90° from
+  // the axis at the sampled pixels (EUCM alpha 1, beta 100: rays only
+  // within 2 px of the centre; alpha 0.8, beta 4 on a small focal length):
+  // the model sees no ray beyond, so the image past it has none, as
+  // outside a fisheye's circle.
+  EXPECT_EQ(ProjectionOverImageError(16, {20, 20, 160, 120, 1, 100}, 320,
+                                     240),
+            "");
+  EXPECT_EQ(ProjectionOverImageError(16, {300, 300, 640, 480, 0.8, 4.0},
+                                     1280, 960),
+            "");
   // A principal point off the image centre, and one just outside the image.
   EXPECT_EQ(ProjectionOverImageError(1, {500, 500, 300, 200}, 640, 480), "");
   EXPECT_EQ(ProjectionOverImageError(1, {500, 500, -100, 200}, 640, 480), "");
@@ -54,16 +65,20 @@ TEST(ProjectionCheck, RefusesAbsurdValuesNamingWhy) {
   const std::string omni_fold = ProjectionOverImageError(
       64, {300, 300, 640, 480, 1.0, -0.9, 0, 0, 0}, 1280, 960);
   EXPECT_THAT(omni_fold, HasSubstr("UNIFIED_OMNI"));
+  // Pixels that lose their ray before 90° though the model projects rays
+  // further out: the message names the angle where the inverse stops.
+  EXPECT_THAT(omni_fold, HasSubstr("from the axis"));
   // A principal point a thousand images away.
   EXPECT_THAT(ProjectionOverImageError(1, {500, 500, 1e6, 240}, 640, 480),
               HasSubstr("far outside the 640x480 image"));
   EXPECT_THAT(ProjectionOverImageError(16, {400, 400, 640, -1e7, 0.6, 1.0},
                                        1280, 960),
               HasSubstr("far outside"));
-  // A focal length so small that no pixel but the centre has a ray.
-  EXPECT_FALSE(ProjectionOverImageError(16, {1e-3, 1e-3, 640, 480, 0.9, 5.0},
-                                        1280, 960)
-                   .empty());
+  // A focal length so small that no pixel but the centre has a ray: the
+  // model's domain ends 0.0005 px from it.
+  EXPECT_THAT(ProjectionOverImageError(16, {1e-3, 1e-3, 640, 480, 0.9, 5.0},
+                                       1280, 960),
+              HasSubstr("covers less than a pixel"));
 }
 
 // Nothing to check without an image size.

@@ -254,6 +254,11 @@ DAMAGED_DATABASES = [
     ("equirectangular w,h other than the image size", sql_damage(
         "UPDATE cameras SET model = 17, "
         "params = x'00000000000084400000000000007440'")),
+    # UNIFIED_OMNI whose k2 is 1e300: each value allowed, no projection
+    # that can be inverted over the 320x240 image.
+    ("UNIFIED_OMNI k2 = 1e300", sql_damage(
+        "UPDATE cameras SET model = 64, params = x'" + struct.pack(
+            "<9d", 200, 200, 160, 120, 1, 0, 1e300, 0, 0).hex() + "'")),
     ("image of a missing camera", sql_damage(
         "UPDATE images SET camera_id = 77 WHERE image_id = 2")),
     ("frame of a missing image", sql_damage(

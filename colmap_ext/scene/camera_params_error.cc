@@ -1,5 +1,6 @@
 #include "colmap_ext/scene/camera_params_error.h"
 
+#include "camera_models/projection_check.h"
 #include "camera_models/registry.h"
 
 #include <cmath>
@@ -26,10 +27,18 @@ std::string CameraParamsError(const Camera& camera) {
   if (sphera::IsSphereModel(static_cast<int>(model_id))) {
     // EUCM, EQUIRECTANGULAR, UNIFIED_OMNI, DOUBLE_SPHERE: SPHERA's checks
     // (EQUIRECTANGULAR: w = 2 h and w, h = the image size).
-    return sphera::CheckParams(static_cast<int>(model_id),
-                               params,
-                               static_cast<int>(camera.width),
-                               static_cast<int>(camera.height));
+    // Then whether the values, each allowed, leave a projection that can
+    // be inverted over the image (no distortion that breaks off or folds,
+    // no axis far outside the image).
+    const int width = static_cast<int>(camera.width);
+    const int height = static_cast<int>(camera.height);
+    std::string error = sphera::CheckParams(
+        static_cast<int>(model_id), params, width, height);
+    if (error.empty()) {
+      error = sphera::ProjectionOverImageError(
+          static_cast<int>(model_id), params, width, height);
+    }
+    return error;
   }
   for (const double value : params) {
     if (!std::isfinite(value)) {
