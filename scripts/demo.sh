@@ -26,9 +26,11 @@
 # verified, images registered), a progress line while a stage runs on a
 # terminal, and a summary; the output of every command (setup, build,
 # COLMAP) goes to the log file it names, demo.log in the output folder.
-# Output goes to SPHERA_DEMO_DIR (default build/demo): database.db, sparse/,
-# demo.log, and for the default scene the rendered images and the ground
-# truth.
+# RANSAC and the mapper draw from SPHERA_DEMO_SEED (default 0), so that a
+# run on the same images gives the same model; another seed is another
+# draw. Output goes to SPHERA_DEMO_DIR (default build/demo): database.db,
+# sparse/, demo.log, and for the default scene the rendered images and the
+# ground truth.
 #
 # From a clone it installs the packages and builds first (scripts/setup.sh,
 # scripts/build.sh). SPHERA_COLMAP and SPHERA_RENDER name the programs to run
@@ -51,6 +53,7 @@ else
   readonly RENDER="${SPHERA_RENDER:-${BUILD_DIR}/synthetic/sphera_render}"
 fi
 readonly LOG="${WORK_DIR}/demo.log"
+readonly SEED="${SPHERA_DEMO_SEED:-0}"
 
 camera=""
 if [ "${1:-}" = "--camera" ]; then
@@ -245,7 +248,7 @@ fi
 
 run_stage "matching" 's/.*Processing block \[\(.*\)\].*/block \1/p' \
   "${COLMAP}" exhaustive_matcher --database_path "${database}" \
-  --FeatureMatching.use_gpu 0
+  --FeatureMatching.use_gpu 0 --TwoViewGeometry.random_seed "${SEED}"
 echo "matching:           $(sql 'SELECT COUNT(*) FROM two_view_geometries
   WHERE rows > 0') of $(sql 'SELECT COUNT(*) FROM matches') image pairs" \
   "verified (${stage_seconds} s)"
@@ -261,25 +264,45 @@ mkdir -p "${WORK_DIR}/sparse"
 run_stage "mapping" \
   's/.*Registering image #[0-9]* (num_reg_frames=\([0-9]*\)).*/\1 images registered/p' \
   "${COLMAP}" mapper --database_path "${database}" --image_path "${image_dir}" \
-  --output_path "${WORK_DIR}/sparse"
+  --output_path "${WORK_DIR}/sparse" --Mapper.random_seed "${SEED}"
 models=0
 registered=""
+largest=0
+largest_points=0
+best_model=""
 for model in "${WORK_DIR}"/sparse/*/; do
   [ -d "${model}" ] || continue
   models=$(( models + 1 ))
-  count="$("${COLMAP}" model_analyzer --path "${model}" 2>&1 \
-    | sed -n 's/.*Registered images: \([0-9]*\).*/\1/p')"
+  statistics="$("${COLMAP}" model_analyzer --path "${model}" 2>&1)"
+  count="$(sed -n 's/.*Registered images: \([0-9]*\).*/\1/p' \
+    <<<"${statistics}")"
+  points="$(sed -n 's/.*Points: \([0-9]*\).*/\1/p' <<<"${statistics}")"
   registered="${registered:+${registered} + }${count}"
+  # The largest model: most images, then most points.
+  if [ "${count:-0}" -gt "${largest}" ] || { [ "${count:-0}" -eq "${largest}" ] \
+      && [ "${points:-0}" -gt "${largest_points}" ]; }; then
+    largest="${count:-0}"
+    largest_points="${points:-0}"
+    best_model="${model%/}"
+  fi
 done
-echo "mapping:            ${registered:-0} of $(sql 'SELECT COUNT(*) FROM images')" \
-  "images registered in ${models} model(s) (${stage_seconds} s)"
-if [ -n "${rig_config}" ] && [ -d "${WORK_DIR}/sparse/0" ]; then
+# Models of one run may share images: the largest model's count, and each
+# model's beside it when there are several.
+if [ "${models}" -gt 1 ]; then
+  where="the largest of ${models} models (${registered})"
+else
+  where="${models} model"
+fi
+echo "mapping:            ${largest} of $(sql 'SELECT COUNT(*) FROM images')" \
+  "images registered in ${where} (${stage_seconds} s)"
+if [ -n "${rig_config}" ] && [ -n "${best_model}" ]; then
   mkdir -p "${WORK_DIR}/rig_calibration"
   run_stage "rig calibration" 's/^$//p' "${COLMAP}" rig_calibration \
-    --input_path "${WORK_DIR}/sparse/0" \
+    --input_path "${best_model}" \
     --output_path "${WORK_DIR}/rig_calibration"
-  echo "rig calibration:    lens poses and intrinsics in" \
-    "${WORK_DIR}/rig_calibration (${stage_seconds} s)"
+  echo "rig calibration:    lens poses and intrinsics of model" \
+    "$(basename "${best_model}") in ${WORK_DIR}/rig_calibration" \
+    "(${stage_seconds} s)"
 fi
 elapsed=$(( $(date +%s) - start ))
 
@@ -290,11 +313,11 @@ echo "keypoints:       $(sql 'SELECT SUM(rows) FROM keypoints')"
 echo "verified pairs:  $(sql 'SELECT COUNT(*) FROM two_view_geometries WHERE rows > 0')"
 # A scene rendered by sphera_render holds its ground truth beside images/.
 scene_dir="$(dirname "${image_dir}")"
-if [ -d "${scene_dir}/sparse_gt" ] && [ -d "${WORK_DIR}/sparse/0" ]; then
+if [ -d "${scene_dir}/sparse_gt" ] && [ -n "${best_model}" ]; then
   echo "--- against the ground truth (colmap model_evaluator) ---"
   mkdir -p "${WORK_DIR}/evaluation"
   "${COLMAP}" model_evaluator --gt_path "${scene_dir}/sparse_gt" \
-    --input_path "${WORK_DIR}/sparse/0" --depth_path "${scene_dir}/depth" \
+    --input_path "${best_model}" --depth_path "${scene_dir}/depth" \
     --output_path "${WORK_DIR}/evaluation" 2>>"${LOG}" | tail -n 7
 fi
 for model in "${WORK_DIR}"/sparse/*/; do

@@ -162,6 +162,34 @@ def byte_damage(change):
     return make
 
 
+def swapped_pages(first, second):
+    """A damage that swaps two pages of the matched database's file: the
+    first page of table FIRST's b-tree (its root) and the first overflow
+    page of table SECOND's rows (SQLite's dbstat table names them)."""
+    def make(path):
+        connection = sqlite3.connect(f"file:{Scene.database}?mode=ro",
+                                     uri=True)
+        try:
+            page_size = connection.execute("PRAGMA page_size").fetchone()[0]
+            a = connection.execute(
+                "SELECT MIN(pageno) FROM dbstat WHERE name = ?",
+                (first,)).fetchone()[0]
+            b = connection.execute(
+                "SELECT MIN(pageno) FROM dbstat WHERE name = ? AND "
+                "pagetype = 'overflow'", (second,)).fetchone()[0]
+        finally:
+            connection.close()
+        with open(Scene.database, "rb") as f:
+            data = bytearray(f.read())
+        # dbstat counts pages from 1.
+        a, b = (a - 1) * page_size, (b - 1) * page_size
+        data[a:a + page_size], data[b:b + page_size] = (
+            data[b:b + page_size], data[a:a + page_size])
+        with open(path, "wb") as f:
+            f.write(data)
+    return make
+
+
 def random_bytes(n, seed):
     rng = random.Random(seed)
     return bytes(rng.getrandbits(8) for _ in range(n))
@@ -176,6 +204,10 @@ DAMAGED_DATABASES = [
     ("a text file", byte_damage(lambda d: b"not a database\n" * 200)),
     ("4 KiB zeroed in the middle", byte_damage(
         lambda d: d[:len(d) // 2] + bytes(4096) + d[len(d) // 2 + 4096:])),
+    ("a page of images swapped with one of keypoints",
+     swapped_pages("images", "keypoints")),
+    ("a page of two_view_geometries swapped with one of descriptors",
+     swapped_pages("two_view_geometries", "descriptors")),
     ("SQLite, not COLMAP", sql_damage(
         "DROP TABLE keypoints", "DROP TABLE descriptors", "DROP TABLE matches",
         "DROP TABLE two_view_geometries", "DROP TABLE frame_data",
