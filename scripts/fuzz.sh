@@ -18,6 +18,10 @@
 #   fuzz_camera_params   the check of --ImageReader.camera_model/_params
 #                        (colmap_ext/controllers/image_errors.cc and
 #                        colmap_ext/scene/camera_params_error.cc)
+#   fuzz_matching        COLMAP's geometric verifier and exhaustive matcher
+#                        on every database the check above lets through
+#                        (the check instrumented, matching linked from the
+#                        build): no exception may leave a matching thread
 #   fuzz_model_readers   COLMAP's text and binary model readers as patched
 #                        (the two reader sources instrumented, the rest of
 #                        COLMAP linked from the build, as build.ninja links
@@ -47,8 +51,8 @@ readonly BUILD_DIR="${SPHERA_BUILD_DIR:-${REPO_ROOT}/build}"
 readonly WORK="${BUILD_DIR}/fuzz"
 readonly COLMAP="${BUILD_DIR}/bin/colmap"
 readonly RENDER="${BUILD_DIR}/synthetic/sphera_render"
-readonly ALL_TARGETS=(fuzz_database_check fuzz_image_bytes fuzz_camera_params
-                      fuzz_model_readers fuzz_rig_config
+readonly ALL_TARGETS=(fuzz_database_check fuzz_matching fuzz_image_bytes
+                      fuzz_camera_params fuzz_model_readers fuzz_rig_config
                       fuzz_calibration_import fuzz_camera_presets)
 # COLMAP's log lines of every rejected input would cost most of the time.
 export GLOG_minloglevel=3
@@ -60,7 +64,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --runs) runs="$2"; shift 2 ;;
     --minutes) minutes="$2"; shift 2 ;;
-    -h|--help) sed -n '2,31p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,46p' "$0"; exit 0 ;;
     fuzz_*) targets+=("$1"); shift ;;
     *) echo "fuzz.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
@@ -111,7 +115,7 @@ build_target() {
       sources=($(ls "${REPO_ROOT}"/calibration/*.cc | grep -v _test.cc))
       cflags=(-I /usr/include/opencv4)
       libraries=(-lopencv_core -lyaml-cpp -lceres -lglog) ;;
-    fuzz_database_check|fuzz_camera_params|fuzz_model_readers|fuzz_rig_config)
+    fuzz_database_check|fuzz_matching|fuzz_camera_params|fuzz_model_readers|fuzz_rig_config)
       # The sources under test instrumented, the rest of COLMAP linked from
       # the build with the flags of one of its objects.
       local object="build colmap/src/colmap/scene/CMakeFiles/colmap_scene.dir/reconstruction_io_binary.cc.o:"
@@ -119,7 +123,7 @@ build_target() {
       sources=("${scene}/reconstruction_io_binary.cc"
                "${scene}/reconstruction_io_text.cc")
       [ "${target}" = fuzz_rig_config ] && sources=("${scene}/rig.cc")
-      [ "${target}" = fuzz_database_check ] && sources=(
+      [ "${target}" = fuzz_database_check ] || [ "${target}" = fuzz_matching ] && sources=(
           "${REPO_ROOT}/colmap_ext/scene/database_check.cc"
           "${REPO_ROOT}/colmap_ext/scene/camera_params_error.cc")
       [ "${target}" = fuzz_camera_params ] && sources=(
@@ -165,9 +169,10 @@ build_target() {
 make_seeds() {
   local seeds="${WORK}/seeds"
   # "done" names the version of this recipe: seeds of an older one are remade.
-  [ "$(cat "${seeds}/done" 2>/dev/null)" = 2 ] && return
+  [ "$(cat "${seeds}/done" 2>/dev/null)" = 3 ] && return
   rm -rf "${seeds}" "${WORK}/scene" "${WORK}/scene_png" "${WORK}"/rig_*
-  mkdir -p "${seeds}/fuzz_database_check" "${seeds}/fuzz_image_bytes" \
+  mkdir -p "${seeds}/fuzz_database_check" "${seeds}/fuzz_matching" \
+    "${seeds}/fuzz_image_bytes" \
     "${seeds}/fuzz_model_readers" "${seeds}/fuzz_camera_params" \
     "${seeds}/fuzz_rig_config"
   local k=0
@@ -214,6 +219,7 @@ target.execute("VACUUM")
 target.close()
 source.close()
 EOF
+  cp "${seeds}/fuzz_database_check/seed.db" "${seeds}/fuzz_matching/seed.db"
   # The model: bad_model_test's small valid model, in both formats; a seed
   # is a file of it behind the byte that names it (bit 0: binary, then the
   # file's index in rigs, cameras, frames, images, points3D).
@@ -236,7 +242,7 @@ for binary, (folder, extension) in enumerate((("text", ".txt"), ("binary", ".bin
         with open(f"{seeds}/{folder}_{name}", "wb") as f:
             f.write(bytes([(index << 1) | binary]) + data)
 EOF
-  echo 2 > "${seeds}/done"
+  echo 3 > "${seeds}/done"
 }
 
 # Seeds of fuzz_calibration_import: a small file of each format behind the
