@@ -661,6 +661,39 @@ class BadOptionTest(BadInputCase):
                      "--output_path", out, *extra])
                 self.assert_named_error(code, output, names, case)
                 self.assertEqual(os.listdir(out), [], case)
+        # The model's camera replaced by one whose values are each allowed
+        # but leave no usable projection over the 320x240 image.
+        text_model = self.path("text_model")
+        os.makedirs(text_model)
+        run_colmap("model_converter", "--input_path", Scene.model,
+                   "--output_path", text_model, "--output_type", "TXT")
+        edge_cameras = [
+            ("PINHOLE principal point far outside",
+             "PINHOLE 320 240 250 250 1000000 120", "PINHOLE principal point"),
+            ("UNIFIED_OMNI k2 = 1e300",
+             "UNIFIED_OMNI 320 240 200 200 160 120 1 0 1e300 0 0",
+             "UNIFIED_OMNI"),
+        ]
+        for index, (case, camera, name) in enumerate(edge_cameras):
+            model = self.path(f"edge_model{index}")
+            shutil.copytree(text_model, model)
+            with open(os.path.join(model, "cameras.txt")) as f:
+                lines = f.read().splitlines()
+            with open(os.path.join(model, "cameras.txt"), "w") as f:
+                for text in lines:
+                    if text and not text.startswith("#"):
+                        text = text.split()[0] + " " + camera
+                    f.write(text + "\n")
+            for command in ("image_undistorter", "sphere_undistorter"):
+                out = self.path(f"edge_out{index}_{command}")
+                os.makedirs(out)
+                with self.subTest(case=case, command=command):
+                    code, output = run_bounded(
+                        [command, "--input_path", model, "--image_path",
+                         Scene.images, "--output_path", out])
+                    self.assert_named_error(code, output, ["camera 1", name],
+                                            case)
+                    self.assertEqual(os.listdir(out), [], case)
         # The same commands on the intact model write their workspaces.
         for command in ("image_undistorter", "sphere_undistorter"):
             out = self.path("valid_" + command)

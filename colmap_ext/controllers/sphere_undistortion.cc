@@ -950,10 +950,22 @@ std::string ImageUndistorterInputError(
     return "no view to write: no image of " + image_list_path.string() +
            " is in the reconstruction";
   }
-  const std::string missing = MissingImageFiles(
-      reconstruction,
-      image_ids.empty() ? reconstruction.RegImageIds() : image_ids,
-      image_path);
+  const std::vector<image_t> selected =
+      image_ids.empty() ? reconstruction.RegImageIds() : image_ids;
+  // A camera whose parameters leave no usable projection (a principal
+  // point far outside the image, a distortion that cannot be inverted)
+  // would fill every view with nothing.
+  for (const image_t image_id : selected) {
+    if (!reconstruction.ExistsImage(image_id)) continue;
+    const Image& image = reconstruction.Image(image_id);
+    const Camera& camera = reconstruction.Camera(image.CameraId());
+    if (const std::string error = CameraParamsError(camera); !error.empty()) {
+      return "image " + image.Name() + ": camera " +
+             std::to_string(camera.camera_id) + ": " + error;
+    }
+  }
+  const std::string missing =
+      MissingImageFiles(reconstruction, selected, image_path);
   if (!missing.empty()) {
     return missing + " (--image_list_path selects images)";
   }

@@ -57,6 +57,25 @@ std::string CameraParamsError(const Camera& camera) {
       return message.str();
     }
   }
+  // A principal point more than an image size outside the image is no
+  // lens's (the sphere models' projection check says the same of their
+  // optical axis); upstream's models are otherwise checked as upstream does.
+  const span<const size_t> principal_point_idxs =
+      CameraModelPrincipalPointIdxs(model_id);
+  if (principal_point_idxs.size() == 2 && camera.width > 0 &&
+      camera.height > 0) {
+    const double cx = params[principal_point_idxs[0]];
+    const double cy = params[principal_point_idxs[1]];
+    const double width = static_cast<double>(camera.width);
+    const double height = static_cast<double>(camera.height);
+    if (cx < -width || cx > 2 * width || cy < -height || cy > 2 * height) {
+      std::ostringstream message;
+      message << name << " principal point (" << cx << ", " << cy
+              << ") lies far outside the " << camera.width << "x"
+              << camera.height << " image (more than an image size from it)";
+      return message.str();
+    }
+  }
   return "";
 }
 
