@@ -211,7 +211,8 @@ CalibrationFormat CalibrationFormatFromName(const std::string& name) {
         CalibrationFormat::kBasalt}) {
     if (lower == CalibrationFormatName(format)) return format;
   }
-  throw std::invalid_argument("unknown calibration format \"" + name +
+  throw std::invalid_argument("--format: unknown calibration format \"" +
+                              name +
                               "\" (auto, kalibr, opencv, ocamcalib, basalt)");
 }
 

@@ -518,9 +518,12 @@ ResolvedPreset ResolveRigPreset(const RigPresetRequest& request) {
   resolved.preset = &FindCameraPreset(request.camera);
   const CameraPreset& preset = *resolved.preset;
   const bool has_size = request.image_width != 0 || request.image_height != 0;
-  if (has_size && (request.image_width <= 0 || request.image_height <= 0)) {
+  if (has_size && (request.image_width <= 0 || request.image_height <= 0 ||
+                   request.image_width > 999999 ||
+                   request.image_height > 999999)) {
     throw std::invalid_argument(
-        "--image_width and --image_height go together and are positive, got " +
+        "--image_width and --image_height go together and are in [1, "
+        "999999], got " +
         std::to_string(request.image_width) + " and " +
         std::to_string(request.image_height));
   }

@@ -552,6 +552,54 @@ class BadOptionTest(BadInputCase):
                 self.assertEqual(os.listdir(out), [], case)
         self.assertEqual(len(BAD_OPTIONS), 30)
 
+    def test_sphera_option_ranges_are_named_errors(self):
+        """Values outside the documented range of SPHERA's own commands'
+        options are named before any work: nothing is written and the
+        database is unchanged."""
+        database = self.path("sphera_options.db")
+        shutil.copy(Scene.database, database)
+        before = database_state(database)
+        calibration = self.path("calibration.yaml")
+        with open(calibration, "w") as f:
+            f.write("cam0:\n  camera_model: pinhole\n")
+        # (command and its arguments, option and value, names in the error);
+        # OUT is the output folder, which must stay empty.
+        cases = [
+            (["sphere_bundle_adjuster", "--input_path", Scene.model,
+              "--output_path", "OUT"], ["--loss_scale_px", "-1"],
+             ["--loss_scale_px"]),
+            (["sphere_bundle_adjuster", "--input_path", Scene.model,
+              "--output_path", "OUT"], ["--tau_px", "0"], ["--tau_px"]),
+            (["rig_check", "--database_path", database],
+             ["--min_num_inliers", "1000000"], ["--min_num_inliers"]),
+            (["rig_check", "--database_path", database],
+             ["--max_angle_deg", "270"], ["--max_angle_deg"]),
+            (["rig_preset", "--camera", "dual_fisheye", "--output_path",
+              "OUT/rig_config.json"],
+             ["--image_width", "2000000", "--image_height", "1000000"],
+             ["--image_width"]),
+            (["calibration_importer", "--input_path", calibration,
+              "--output_path", "OUT"], ["--format", "matlab"],
+             ["--format", "matlab"]),
+            (["dual_fisheye_splitter", "--input_path", Scene.images,
+              "--output_path", "OUT"], ["--circles", "80,60,50;240,60,0"],
+             ["--circles", "radius of lens 1"]),
+            (["dual_fisheye_splitter", "--input_path", Scene.images,
+              "--output_path", "OUT"], ["--black_level", "300"],
+             ["--black_level"]),
+        ]
+        for index, (args, values, names) in enumerate(cases):
+            out = self.path(f"sphera_out{index}")
+            os.makedirs(out)
+            args = [out if a == "OUT" else a.replace("OUT/", out + "/")
+                    for a in args]
+            case = " ".join([args[0]] + values)
+            with self.subTest(case=case):
+                code, output = run_bounded(args + values)
+                self.assert_named_error(code, output, names, case)
+                self.assertEqual(os.listdir(out), [], case)
+        self.assertEqual(database_state(database), before)
+
     def test_sphere_bundle_adjuster_enums_in_any_letter_case(self):
         """Its --mode, --residual and --loss take the enum names in any
         letter case, as COLMAP's own enum options; another word is named."""

@@ -909,6 +909,13 @@ void DualFisheyeSplittingOptions::Check() const {
         !error.empty()) {
       throw std::invalid_argument("--circles: " + error);
     }
+    for (int lens = 0; lens < 2; ++lens) {
+      if (!(parsed[lens].r > 0)) {
+        throw std::invalid_argument(
+            "--circles: the radius of lens " + std::to_string(lens) +
+            " must be > 0, got " + ShortestDoubleText(parsed[lens].r));
+      }
+    }
   }
 }
 

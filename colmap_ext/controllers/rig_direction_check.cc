@@ -99,8 +99,8 @@ std::string RigCheckOptions::Check() const {
     return "--max_ray_error_deg must be in (0, 90), got " +
            Format("%g", max_ray_error_deg);
   }
-  if (min_num_inliers < 3) {
-    return "--min_num_inliers must be at least 3, got " +
+  if (min_num_inliers < 3 || min_num_inliers > 100000) {
+    return "--min_num_inliers must be in [3, 100000], got " +
            std::to_string(min_num_inliers);
   }
   return "";

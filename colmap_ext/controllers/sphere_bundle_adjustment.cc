@@ -553,8 +553,7 @@ std::string SphereBundleAdjustmentOptions::Check() const {
     return "--max_iterations must be >= 1, got " +
            std::to_string(max_iterations);
   }
-  if (loss == Loss::CAUCHY &&
-      (!(loss_scale_px > 0) || !std::isfinite(loss_scale_px))) {
+  if (!(loss_scale_px > 0) || !std::isfinite(loss_scale_px)) {
     return "--loss_scale_px must be > 0, got " + std::to_string(loss_scale_px);
   }
   if (min_observations_per_image < 3) {
