@@ -324,6 +324,18 @@ class DualFisheyeSplitterTest(TempDirTestCase):
                             "--camera_model", "OPENCV_FISHEYE",
                             "--camera_params", "1,2,3")
         self.assert_refused(["--black_level"], "--black_level", "300")
+        # A camera that is no lens for the 96x88 lens images: a focal length
+        # of 0, a principal point a thousand images away.
+        self.assert_refused(["--camera_params", "focal length",
+                             "96x88 lens images"], *given,
+                            "--camera_model", "OPENCV_FISHEYE",
+                            "--camera_params", "0,40,48,44,0,0,0,0")
+        self.assert_refused(["--camera_params", "principal point",
+                             "96x88 lens images"], *given,
+                            "--camera_model", "OPENCV_FISHEYE",
+                            "--camera_params", "40,40,96000,44,0,0,0,0")
+        self.assert_refused(["--circles", "radius of lens 1"],
+                            "--circles", "48,44,40;48,44,0")
 
         # Only good.png is left: it splits.
         self.split(*given)

@@ -4,6 +4,7 @@
 #include "colmap/sensor/models.h"
 #include "colmap/util/logging.h"
 #include "colmap_ext/image/dual_fisheye_split.h"
+#include "colmap_ext/scene/camera_params_error.h"
 #include "colmap_ext/util/file_output.h"
 #include "synthetic/file_formats.h"
 
@@ -83,6 +84,22 @@ std::array<std::string, 2> ParseLensNames(const std::string& text) {
   return {names[0], names[1]};
 }
 
+// The numbers of --camera_params.
+std::vector<double> CameraParamsValues(const std::string& params_text) {
+  std::vector<double> params;
+  for (const std::string& value_text : SplitText(params_text, ',')) {
+    const std::string trimmed = Trim(value_text);
+    char* end = nullptr;
+    const double value = std::strtod(trimmed.c_str(), &end);
+    if (trimmed.empty() || *end != '\0' || !std::isfinite(value)) {
+      throw std::invalid_argument("--camera_params: \"" + value_text +
+                                  "\" is not a number");
+    }
+    params.push_back(value);
+  }
+  return params;
+}
+
 // The camera for rig_config.json: a model COLMAP knows and parameters it
 // accepts for it, written back as given (shortest round-trip text).
 std::string CameraJson(const std::string& model,
@@ -99,17 +116,7 @@ std::string CameraJson(const std::string& model,
     throw std::invalid_argument("--camera_model: no camera model \"" + model +
                                 "\"");
   }
-  std::vector<double> params;
-  for (const std::string& value_text : SplitText(params_text, ',')) {
-    const std::string trimmed = Trim(value_text);
-    char* end = nullptr;
-    const double value = std::strtod(trimmed.c_str(), &end);
-    if (trimmed.empty() || *end != '\0' || !std::isfinite(value)) {
-      throw std::invalid_argument("--camera_params: \"" + value_text +
-                                  "\" is not a number");
-    }
-    params.push_back(value);
-  }
+  const std::vector<double> params = CameraParamsValues(params_text);
   const CameraModelId model_id = CameraModelNameToId(model);
   if (!CameraModelVerifyParams(model_id, params)) {
     throw std::invalid_argument(
@@ -954,6 +961,21 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
   }
   const FrameScan scan =
       ScanFrames(frames, lens_names, given_circles, options.black_level);
+  if (!options.camera_model.empty()) {
+    // The lenses' camera as the mapper will check it, on the lens images'
+    // size (a focal length of 0, a principal point far off the image).
+    Camera camera;
+    camera.model_id = CameraModelNameToId(options.camera_model);
+    camera.width = scan.lens_size.width;
+    camera.height = scan.lens_size.height;
+    camera.params = CameraParamsValues(options.camera_params);
+    if (const std::string error = CameraParamsError(camera); !error.empty()) {
+      throw std::invalid_argument(
+          "--camera_params: " + error + " (for the " +
+          std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+          " lens images)");
+    }
+  }
   std::array<ImageCircle, 2> circles;
   if (given_circles) {
     circles = *given_circles;
