@@ -552,6 +552,33 @@ class BadOptionTest(BadInputCase):
                 self.assertEqual(os.listdir(out), [], case)
         self.assertEqual(len(BAD_OPTIONS), 30)
 
+    def test_cameras_without_a_usable_projection_are_not_extracted(self):
+        """A camera given on the command line whose values are each allowed
+        but leave no projection over the images (UNIFIED_OMNI with k2 =
+        1e300, a principal point a thousand images away) is named before
+        any image is extracted; the database holds no image."""
+        cases = [
+            ("UNIFIED_OMNI", "200,200,160,120,1,0,1e300,0,0", "UNIFIED_OMNI"),
+            ("PINHOLE", "250,250,320000,120", "principal point"),
+        ]
+        for index, (model, params, name) in enumerate(cases):
+            database = self.path(f"camera{index}.db")
+            with self.subTest(model=model):
+                code, output = run_bounded(
+                    ["feature_extractor", "--database_path", database,
+                     "--image_path", Scene.images, "--ImageReader.camera_model",
+                     model, "--ImageReader.camera_params", params,
+                     "--ImageReader.single_camera", "1", *CPU])
+                self.assert_named_error(code, output, [name], model,
+                                        internal_checks=True)
+                if os.path.exists(database):
+                    connection = sqlite3.connect(database)
+                    try:
+                        self.assertEqual(connection.execute(
+                            "SELECT count(*) FROM images").fetchone()[0], 0)
+                    finally:
+                        connection.close()
+
     def test_sphera_option_ranges_are_named_errors(self):
         """Values outside the documented range of SPHERA's own commands'
         options are named before any work: nothing is written and the
