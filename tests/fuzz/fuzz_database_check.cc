@@ -4,31 +4,24 @@
 // The check and the camera parameter check it calls are instrumented, the
 // rest of COLMAP (its camera model table) linked from the build.
 #include "colmap_ext/scene/database_check.h"
-
-#include <unistd.h>
+#include "tests/fuzz/database_input.h"
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const std::string path =
-      "/dev/shm/sphera_fuzz_database_" + std::to_string(getpid()) + ".db";
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) {
+  const std::string path =
+      sphera_fuzz::WriteDatabaseInput("fuzz_database", data, size);
+  if (path.empty()) {
     return 0;
   }
-  std::fwrite(data, 1, size, file);
-  std::fclose(file);
   try {
     colmap::CheckDatabaseFile(path, 4020000);
   } catch (const std::runtime_error&) {
     // A named error is the expected outcome for most inputs.
   }
-  std::remove(path.c_str());
-  std::remove((path + "-wal").c_str());
-  std::remove((path + "-shm").c_str());
+  sphera_fuzz::RemoveDatabase(path);
   return 0;
 }

@@ -18,24 +18,15 @@
 #include "colmap/feature/matcher.h"
 #include "colmap/scene/database.h"
 #include "colmap_ext/scene/database_check.h"
-
-#include <unistd.h>
+#include "tests/fuzz/database_input.h"
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
 #include <exception>
 #include <stdexcept>
 #include <string>
 
 namespace {
-
-void RemoveDatabase(const std::string& path) {
-  std::remove(path.c_str());
-  std::remove((path + "-wal").c_str());
-  std::remove((path + "-shm").c_str());
-  std::remove((path + "-journal").c_str());
-}
 
 void RunThread(colmap::Thread* thread) {
   thread->Start();
@@ -80,29 +71,24 @@ void Match(const std::string& path) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const std::string path =
-      "/dev/shm/sphera_fuzz_matching_" + std::to_string(getpid()) + ".db";
-  RemoveDatabase(path);
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) {
+  const std::string path =
+      sphera_fuzz::WriteDatabaseInput("fuzz_matching", data, size);
+  if (path.empty()) {
     return 0;
   }
-  std::fwrite(data, 1, size, file);
-  std::fclose(file);
   try {
     colmap::CheckDatabaseFile(path, 4020000);
   } catch (const std::runtime_error&) {
     // A named error: nothing reaches matching.
-    RemoveDatabase(path);
+    sphera_fuzz::RemoveDatabase(path);
     return 0;
   }
-
   try {
     Match(path);
   } catch (const std::exception&) {
     // Raised on the calling thread, as by the matchers' own checks ("no
     // images to match"): the command names it and exits 1.
   }
-  RemoveDatabase(path);
+  sphera_fuzz::RemoveDatabase(path);
   return 0;
 }
