@@ -8,6 +8,7 @@
 #include "colmap/scene/track.h"
 #include "colmap/sensor/models.h"
 #include "colmap/util/logging.h"
+#include "colmap/util/string.h"
 #include "colmap/util/timer.h"
 #include "colmap_ext/image/image_file_structure.h"
 #include "colmap_ext/util/file_output.h"
@@ -303,6 +304,7 @@ std::string ParseCubeFaces(const std::string& list,
   std::set<CubeFace> seen;
   while (std::getline(stream, item, ',')) {
     item = Trim(item);
+    StringToLower(&item);
     if (item.empty()) {
       continue;
     }
@@ -331,7 +333,10 @@ std::string ParseCubeFaces(const std::string& list,
 
 std::string ParseSphereOutputType(const std::string& text,
                                   SphereOutputType* output_type) {
-  if (text == "COLMAP" || text == "colmap") {
+  // In any letter case, as COLMAP's enum options.
+  std::string lower = text;
+  StringToLower(&lower);
+  if (lower == "colmap") {
     *output_type = SphereOutputType::kColmap;
     return "";
   }
@@ -340,11 +345,13 @@ std::string ParseSphereOutputType(const std::string& text,
 
 std::string ParseSphereImageFormat(const std::string& text,
                                    SphereImageFormat* image_format) {
-  if (text == "jpg") {
+  std::string lower = text;
+  StringToLower(&lower);
+  if (lower == "jpg" || lower == "jpeg") {
     *image_format = SphereImageFormat::kJpg;
     return "";
   }
-  if (text == "png") {
+  if (lower == "png") {
     *image_format = SphereImageFormat::kPng;
     return "";
   }

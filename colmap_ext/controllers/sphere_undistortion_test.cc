@@ -385,6 +385,21 @@ TEST(SphereUndistorter, BadOptionsAreNamed) {
                 .find("max_invalid_ratio"),
             std::string::npos);
   EXPECT_EQ(check([](auto* o) { o->faces = " front, up ,down"; }), "");
+  // Names in any letter case, as COLMAP's enum options.
+  EXPECT_EQ(check([](auto* o) {
+              o->faces = "Front,UP";
+              o->image_format = "PNG";
+              o->output_type = "Colmap";
+            }),
+            "");
+  ParsedSphereUndistorterOptions parsed;
+  SphereUndistorterOptions upper;
+  upper.image_format = "JPG";
+  upper.faces = "BACK";
+  ASSERT_EQ(upper.Parse(&parsed), "");
+  EXPECT_EQ(parsed.image_format, SphereImageFormat::kJpg);
+  ASSERT_EQ(parsed.faces.size(), 1);
+  EXPECT_EQ(parsed.faces[0], CubeFace::kBack);
 
   std::vector<CubeFace> faces;
   EXPECT_EQ(ParseCubeFaces("front,right,back,left,up", &faces), "");
