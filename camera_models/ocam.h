@@ -223,6 +223,22 @@ struct OCamModel {
                   std::sqrt(std::abs(params[2] - params[3] * params[4])));
   }
 
+  // The parameters of the same lens in an image scaled by (scale_x,
+  // scale_y): pixel' = (scale_x px, scale_y py). The sensor frame scales by
+  // k = scale_x (the affine map keeps its 1), so f'(k rho) = k f(rho), i.e.
+  // a_i -> a_i k^(1 - i), and c, d take the aspect change scale_y / scale_x.
+  static void Rescale(double scale_x, double scale_y, double* params) {
+    const double k = scale_x;
+    params[0] *= scale_x;
+    params[1] *= scale_y;
+    params[2] *= scale_y / scale_x;
+    params[3] *= scale_y / scale_x;
+    params[5] *= k;
+    params[6] /= k;
+    params[7] /= k * k;
+    params[8] /= k * k * k;
+  }
+
   template <typename T>
   static internal::OCamField FieldOfView(const T* params) {
     const double poly[4] = {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "camera_models/model_test_util.h"
@@ -139,6 +140,32 @@ TEST(OCam, RayPixelRayRoundTripBeyond180Degrees) {
     }
     EXPECT_EQ(num_failed, 0) << field.folds;
     EXPECT_LT(max_error, 1e-9) << field.folds;
+  }
+}
+
+// The rescaled parameters put every ray at the scaled pixel, for an aspect
+// change too, and the scaled image keeps the field of view.
+TEST(OCam, RescaleScalesEveryPixel) {
+  for (const auto& [scale_x, scale_y] :
+       {std::pair{0.5, 0.5}, std::pair{2.0, 2.0}, std::pair{0.5, 0.4}}) {
+    std::vector<double> scaled = kOCamFold;
+    OCamModel::Rescale(scale_x, scale_y, scaled.data());
+    const double theta_max =
+        OCamModel::FieldOfView(kOCamFold.data()).theta_max;
+    EXPECT_NEAR(OCamModel::FieldOfView(scaled.data()).theta_max, theta_max,
+                1e-9);
+    for (const double theta : {0.0, 0.3, 1.2, 1.9}) {
+      for (const double azimuth : {0.0, 1.0, 2.5, -2.0}) {
+        const Eigen::Vector3d ray = RayAt(theta, azimuth);
+        Eigen::Vector2d pixel, scaled_pixel;
+        ASSERT_TRUE(OCamModel::ImageFromRay(kOCamFold.data(), ray.data(),
+                                            pixel.data()));
+        ASSERT_TRUE(OCamModel::ImageFromRay(scaled.data(), ray.data(),
+                                            scaled_pixel.data()));
+        EXPECT_NEAR(scaled_pixel.x(), scale_x * pixel.x(), 1e-7);
+        EXPECT_NEAR(scaled_pixel.y(), scale_y * pixel.y(), 1e-7);
+      }
+    }
   }
 }
 

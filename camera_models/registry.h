@@ -84,16 +84,17 @@ void RequireParamCount(const std::vector<double>& params) {
 }  // namespace internal
 
 // The models whose cameras COLMAP hands to SPHERA's own checks and code paths
-// (ids 16, 17, 64, 65). Deliberately not every model this library knows:
-// OPENCV_FISHEYE and THIN_PRISM_FISHEYE are upstream's own models, which
-// COLMAP keeps handling as upstream does until a COLMAP-side adapter routes
-// them here, and OCAM has no such adapter yet. ModelIdFromName and VisitModel
-// know all models.
+// (ids 5, 10, 16, 17, 64, 65, 66): every model of this library that COLMAP
+// takes through colmap_ext/sensor/sphere_camera_models.h, and
+// EQUIRECTANGULAR. Not PINHOLE and OPENCV, which COLMAP keeps handling as
+// upstream does. ModelIdFromName and VisitModel know all models.
 inline const std::vector<ModelInfo>& SphereModels() {
   static const std::vector<ModelInfo> models = {
+      internal::InfoOf<OpenCVFisheyeModel>(),
+      internal::InfoOf<ThinPrismFisheyeModel>(),
       internal::InfoOf<EUCMModel>(), internal::InfoOf<EquirectangularModel>(),
       internal::InfoOf<UnifiedOmniModel>(),
-      internal::InfoOf<DoubleSphereModel>()};
+      internal::InfoOf<DoubleSphereModel>(), internal::InfoOf<OCamModel>()};
   return models;
 }
 

@@ -44,11 +44,10 @@ TEST(Registry, NamesAndIds) {
     EXPECT_EQ(static_cast<int>(InitialParams(info.id, 1, 2, 1).size()),
               info.num_params);
   }
-  EXPECT_EQ(sphere_ids, (std::vector<int>{16, 17, 64, 65}));
-  for (int id : {16, 17, 64, 65}) EXPECT_TRUE(IsSphereModel(id));
-  // Upstream's fisheye models and OCAM are known but not handed to SPHERA's
-  // COLMAP-side checks.
-  for (int id : {0, 1, 4, 5, 10, 66, -1}) EXPECT_FALSE(IsSphereModel(id));
+  EXPECT_EQ(sphere_ids, (std::vector<int>{5, 10, 16, 17, 64, 65, 66}));
+  for (int id : {5, 10, 16, 17, 64, 65, 66}) EXPECT_TRUE(IsSphereModel(id));
+  // PINHOLE and OPENCV are known but left to COLMAP's own handling.
+  for (int id : {0, 1, 4, -1}) EXPECT_FALSE(IsSphereModel(id));
 }
 
 TEST(Registry, FisheyeAndOCamDispatch) {

@@ -24,6 +24,9 @@ Usage (from the repository root):
 Data sets (rows):
   room9_equirect     9 equirectangular 2048x1024 cameras, room9 layout
   room_fisheye190    12 UNIFIED_OMNI 190-degree fisheye 1024x1024
+  room_fisheye160    the same 12 poses, OPENCV_FISHEYE 160-degree lenses
+                     with the renderer's --realistic sensor effects (cropped
+                     image circle, vignetting, flare, exposure, noise, JPEG)
   room_hybrid        4 equirect + 4 fisheye + 4 PINHOLE 800x600
   room_poles         9 equirectangular 2048x1024, alternately near floor and
                      ceiling: many features near the poles
@@ -36,9 +39,10 @@ Programs: SPHERA build/bin/colmap and build/synthetic/sphera_render, output
 build/bench. Reference "upstream": unpatched upstream COLMAP 4.x at the same
 commit (--upstream_colmap, default ~/.cache/sphera-peers/colmap4/build/src/
 colmap/exe/colmap, built with ../shared/peers/build_colmap4.sh when missing,
-about 40 minutes). It knows EQUIRECTANGULAR and PINHOLE, so it runs on
-room9_equirect, room_poles, room_pinhole_ring, the Strecha sets and
-equirect_flat; the fisheye and hybrid sets get an upstream row "cannot:
+about 40 minutes). It knows EQUIRECTANGULAR, PINHOLE and OPENCV_FISHEYE
+(within its hemisphere), so it runs on room9_equirect, room_fisheye160,
+room_poles, room_pinhole_ring, the Strecha sets and equirect_flat; the
+190-degree fisheye and hybrid sets get an upstream row "cannot:
 camera model UNIFIED_OMNI unknown to upstream". Both systems get the same
 command line (--FeatureExtraction.*, --FeatureMatching.*).
 SPHERA's program always does the evaluation (model_evaluator,
@@ -122,7 +126,8 @@ import sys
 import time
 
 from sphera_common import (REPO_ROOT, SHARED_DATA_DIR, UPSTREAM_COLMAP,
-                           extract_features, fisheye190_rig, hybrid_rig,
+                           extract_features, fisheye160_rig, fisheye190_rig,
+                           hybrid_rig,
                            match_exhaustive, median, model_counts, poles_rig,
                            read_text_cameras, read_text_images, run_logged)
 
@@ -130,6 +135,7 @@ from sphera_common import (REPO_ROOT, SHARED_DATA_DIR, UPSTREAM_COLMAP,
 DATASET_MODELS = {
     "room9_equirect": ["EQUIRECTANGULAR"],
     "room_fisheye190": ["UNIFIED_OMNI"],
+    "room_fisheye160": ["OPENCV_FISHEYE"],
     "room_hybrid": ["EQUIRECTANGULAR", "UNIFIED_OMNI", "PINHOLE"],
     "room_poles": ["EQUIRECTANGULAR"],
     "room_pinhole_ring": ["PINHOLE"],
@@ -148,7 +154,7 @@ BUILD_DIR = os.path.join(REPO_ROOT, "build")
 BUILD_HINT = "scripts/build.sh"
 REFERENCE = "upstream"
 REFERENCE_TITLE = "upstream COLMAP 4.x"
-REFERENCE_MODELS = {"PINHOLE", "EQUIRECTANGULAR"}
+REFERENCE_MODELS = {"PINHOLE", "EQUIRECTANGULAR", "OPENCV_FISHEYE"}
 REFERENCE_BUILDER = os.path.normpath(os.path.join(
     REPO_ROOT, "..", "shared", "peers", "build_colmap4.sh"))
 REFERENCE_BUILD_MINUTES = 40
@@ -356,6 +362,7 @@ RENDERED = {
                                   "EQUIRECTANGULAR", "--width", "2048",
                                   "--height", "1024"]},
     "room_fisheye190": {"rig": fisheye190_rig},
+    "room_fisheye160": {"rig": fisheye160_rig, "options": ["--realistic"]},
     "room_hybrid": {"rig": hybrid_rig},
     "room_poles": {"rig": poles_rig},
     "room_pinhole_ring": {"layout": ["--layout", "ring"]},
@@ -468,6 +475,9 @@ class Benchmark:
         else:
             command += spec["layout"]
             stamp_info["layout"] = spec["layout"]
+        if "options" in spec:
+            command += spec["options"]
+            stamp_info["options"] = spec["options"]
         stamp_path = os.path.join(scene, "bench_stamp.json")
         complete = os.path.exists(os.path.join(scene, "sparse_gt", "images.txt"))
         if complete and os.path.exists(stamp_path):

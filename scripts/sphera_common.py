@@ -524,9 +524,10 @@ EQUIRECT_PARAMS = [2048, 1024]
 PINHOLE_800_PARAMS = [400, 400, 400, 300]  # 90 deg horizontal
 
 
-def fisheye190_rig():
+def fisheye190_rig(model="UNIFIED_OMNI", params=None):
     """12 fisheye cameras: the room9 grid plus 3 off-grid, looking in varied
-    directions (horizontal, tilted, straight up and down)."""
+    directions (horizontal, tilted, straight up and down); 190-degree
+    UNIFIED_OMNI lenses unless `model` and `params` say otherwise."""
     poses = [  # centre, yaw, pitch, roll
         ((-1, 0, -1), 45, 0, 0),
         ((0, 0, -1), 0, 60, 0),
@@ -541,9 +542,21 @@ def fisheye190_rig():
         ((0.5, -0.3, 0.5), 20, 0, 0),
         ((0.5, 0.3, -0.5), -90, 30, 15),
     ]
-    return [rig_line("fish%02d" % i, "UNIFIED_OMNI", 1024, 1024,
-                     FISHEYE_PARAMS, c, yaw, pitch, roll)
+    return [rig_line("fish%02d" % i, model, 1024, 1024,
+                     FISHEYE_PARAMS if params is None else params, c, yaw,
+                     pitch, roll)
             for i, (c, yaw, pitch, roll) in enumerate(poses)]
+
+
+# Kannala-Brandt lens, 1024x1024: 160 degrees across the 537 px image circle
+# of the renderer's --realistic preset (radius 1.05 half heights).
+FISHEYE160_PARAMS = [374.3, 374.3, 512, 512, 0.02, -0.004, 0.0006, -0.00005]
+
+
+def fisheye160_rig():
+    """The 12 poses of fisheye190_rig with OPENCV_FISHEYE lenses under 180
+    degrees, which upstream COLMAP knows too."""
+    return fisheye190_rig("OPENCV_FISHEYE", FISHEYE160_PARAMS)
 
 
 def hybrid_rig():

@@ -301,7 +301,23 @@ class CalibrationImporterTest(TempDirTestCase):
         self.assert_params(cameras["cam0"][1],
                            [640.25, 479.75, 1.0005, 0.0002, -0.0001, -250,
                             0.0012, -1e-06, 2e-09])
-        self.assertIn("--camera_model OPENCV_FISHEYE", stdout)
+        # COLMAP takes the OCAM camera as it is (id 66).
+        images = self.path("images")
+        os.makedirs(images)
+        write_noise_image(os.path.join(images, "frame.pgm"), 1280, 960,
+                          seed=3)
+        database = self.path("database.db")
+        run_colmap("feature_extractor", "--database_path", database,
+                   "--image_path", images,
+                   "--ImageReader.camera_model", "OCAM",
+                   "--ImageReader.camera_params",
+                   ",".join(repr(v) for v in cameras["cam0"][1]),
+                   *CPU_EXTRACTION)
+        db = Database(database)
+        ((model, width, height, params),) = db.cameras().values()
+        db.close()
+        self.assertEqual((model, width, height), (66, 1280, 960))
+        self.assert_params(params, cameras["cam0"][1])
 
         stdout, output = self.run_importer(path, "--camera_model",
                                            "OPENCV_FISHEYE")

@@ -326,7 +326,7 @@ class DualFisheyeSplitterTest(TempDirTestCase):
         self.assert_refused(["--black_level"], "--black_level", "300")
         # A camera that is no lens for the 96x88 lens images: a focal length
         # of 0, a principal point a thousand images away.
-        self.assert_refused(["--camera_params", "focal length",
+        self.assert_refused(["--camera_params", "fx=0 must be positive",
                              "96x88 lens images"], *given,
                             "--camera_model", "OPENCV_FISHEYE",
                             "--camera_params", "0,40,48,44,0,0,0,0")

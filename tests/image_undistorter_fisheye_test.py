@@ -1,5 +1,5 @@
 """`colmap image_undistorter` on images of fisheye lenses beyond 180 degrees
-(UNIFIED_OMNI, EUCM, DOUBLE_SPHERE): each becomes one PINHOLE view along the
+(UNIFIED_OMNI, DOUBLE_SPHERE, OPENCV_FISHEYE): each becomes one PINHOLE view along the
 optical axis that MVS can use, with the observations moved to where the view
 sees their 3D points and the pixels resampled from the fisheye image.
 
@@ -29,11 +29,11 @@ def gray(path):
 
 
 class ImageUndistorterFisheyeTest(TempDirTestCase):
-    def undistort(self, model, *extra):
+    def undistort(self, model, render_extra, *extra):
         scene = self.path("scene_" + model)
         run_render(scene, "--seed", "11", "--layout", "room9", "--model",
                    model, "--width", SIZE, "--height", SIZE, "--supersample",
-                   "2", "--points", "1500", "--format", "png")
+                   "2", "--points", "1500", "--format", "png", *render_extra)
         output = self.path("dense_" + model)
         run_colmap("image_undistorter", "--image_path",
                    os.path.join(scene, "images"), "--input_path",
@@ -44,8 +44,9 @@ class ImageUndistorterFisheyeTest(TempDirTestCase):
                                               output + "_txt"))
         return scene, output, source, views
 
-    def check_views(self, model, max_half_angle_deg, *extra):
-        scene, output, source, views = self.undistort(model, *extra)
+    def check_views(self, model, max_half_angle_deg, *extra, render_extra=()):
+        scene, output, source, views = self.undistort(model, render_extra,
+                                                      *extra)
         src_cameras, src_images, points = source
         cameras, images, view_points = views
         self.assertEqual(len(images), len(src_images))
@@ -109,6 +110,12 @@ class ImageUndistorterFisheyeTest(TempDirTestCase):
     def test_double_sphere_with_a_narrower_cap(self):
         # --max_cam_point_norm caps the view's half-angle: tan(45 deg) = 1.
         self.check_views("DOUBLE_SPHERE", 45, "--max_cam_point_norm", "1")
+
+    def test_opencv_fisheye_200(self):
+        # Kannala-Brandt, 100 degrees from the axis at 0.48 of the image size:
+        # COLMAP's own OPENCV_FISHEYE id beyond the hemisphere.
+        self.check_views("OPENCV_FISHEYE", 60, render_extra=(
+            "--camera_params", "142,142,256,256,0.01,-0.002,0,0"))
 
 
 if __name__ == "__main__":

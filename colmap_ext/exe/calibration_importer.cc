@@ -72,18 +72,11 @@ int RunCalibrationImporter(int argc, char** argv) {
     std::cout << input_path << ": "
               << sphera::CalibrationFormatName(calibration.format) << ", "
               << calibration.cameras.size() << " camera(s)\n";
-    bool has_ocam = false;
     for (const sphera::ImportedCamera& camera : calibration.cameras) {
       PrintCamera(camera);
-      has_ocam = has_ocam || camera.model_name == "OCAM";
     }
     for (const std::string& note : calibration.notes) {
       std::cout << "note: " << note << "\n";
-    }
-    if (has_ocam) {
-      std::cout << "note: COLMAP's mapper does not know OCAM yet; "
-                   "--camera_model OPENCV_FISHEYE (or UNIFIED_OMNI) converts "
-                   "it\n";
     }
     const bool rig = calibration.cameras.size() > 1;
     if (rig) {

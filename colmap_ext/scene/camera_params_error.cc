@@ -25,8 +25,9 @@ std::string CameraParamsError(const Camera& camera) {
     return message.str();
   }
   if (sphera::IsSphereModel(static_cast<int>(model_id))) {
-    // EUCM, EQUIRECTANGULAR, UNIFIED_OMNI, DOUBLE_SPHERE: SPHERA's checks
-    // (EQUIRECTANGULAR: w = 2 h and w, h = the image size).
+    // The sphere models (camera_models/registry.h): SPHERA's checks
+    // (EQUIRECTANGULAR: w = 2 h and w, h = the image size; Kannala-Brandt:
+    // no fold inside the image).
     // Then whether the values, each allowed, leave a projection that can
     // be inverted over the image (no distortion that breaks off or folds,
     // no axis far outside the image).

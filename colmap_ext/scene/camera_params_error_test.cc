@@ -1,5 +1,5 @@
-// The camera check: SPHERA's models by their projection over the image,
-// upstream's by their values.
+// The camera check: SPHERA's models (Kannala-Brandt and OCAM included) by
+// their projection over the image, upstream's by their values.
 #include "colmap_ext/scene/camera_params_error.h"
 
 #include <gmock/gmock.h>
@@ -40,6 +40,15 @@ TEST(CameraParamsError, AcceptsCamerasOfRealLenses) {
   EXPECT_EQ(CameraParamsError(MakeCamera("EUCM", {20, 20, 160, 120, 1, 100},
                                          320, 240)),
             "");
+  // A Kannala-Brandt lens of 200 degrees, and an OCamCalib camera.
+  EXPECT_EQ(CameraParamsError(MakeCamera(
+                "OPENCV_FISHEYE",
+                {142, 142, 256, 256, 0.01, -0.002, 0, 0}, 512, 512)),
+            "");
+  EXPECT_EQ(CameraParamsError(MakeCamera(
+                "OCAM", {500, 400, 1, 0, 0, -300, 1.25e-3, -6e-7, 0}, 1000,
+                800)),
+            "");
 }
 
 TEST(CameraParamsError, RefusesValuesThatLeaveNoLens) {
@@ -59,6 +68,12 @@ TEST(CameraParamsError, RefusesValuesThatLeaveNoLens) {
   EXPECT_THAT(CameraParamsError(MakeCamera("PINHOLE", {0, 500, 320, 240},
                                            640, 480)),
               HasSubstr("focal length"));
+  // Kannala-Brandt whose polynomial turns back 114 px from the centre of
+  // a 512x512 image: SPHERA's check of its fold, not upstream's values.
+  EXPECT_THAT(CameraParamsError(MakeCamera(
+                  "OPENCV_FISHEYE", {142, 142, 256, 256, 0, -0.2, 0, 0}, 512,
+                  512)),
+              HasSubstr("OPENCV_FISHEYE"));
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // COLMAP 4.x adapters for the camera models of camera_models/ whose field of
-// view may exceed a hemisphere: EUCM (16, upstream's id, parameters and file
-// format, but over the model's whole field of view), UNIFIED_OMNI (64) and
-// DOUBLE_SPHERE (65).
+// view may exceed a hemisphere: OPENCV_FISHEYE (5), THIN_PRISM_FISHEYE (10)
+// and EUCM (16) with upstream's ids, parameters and file formats but over the
+// model's whole field of view (rays behind the image plane included), and
+// UNIFIED_OMNI (64), DOUBLE_SPHERE (65) and OCAM (66).
 //
 // colmap/sensor/models.h includes this header after its own model structs,
 // as it includes models_jacobian.h at its end; it needs nothing else from
@@ -10,11 +11,14 @@
 // In COLMAP's taxonomy these models are spherical (IsSpherical(): rays on the
 // whole sphere, cheirality along the ray, errors as angles) with the parameter
 // groups of a perspective model (focal length, principal point and extra
-// parameters, refinable in bundle adjustment) and no metadata parameters.
+// parameters, refinable in bundle adjustment) and no metadata parameters;
+// OCAM has no focal length (its polynomial's a0 plays that part).
 #pragma once
 
 #include "camera_models/double_sphere.h"
 #include "camera_models/eucm.h"
+#include "camera_models/kannala_brandt.h"
+#include "camera_models/ocam.h"
 #include "camera_models/unified_omni.h"
 
 #include <array>
@@ -202,14 +206,19 @@ struct SphereCameraModelAdapter : public BaseSphericalCameraModel<CameraModel> {
   }
 
   // Focal length and principal point follow the image size; the shape
-  // parameters (xi, alpha, beta, distortion) do not depend on it.
+  // parameters (xi, alpha, beta, distortion) do not depend on it. A model
+  // without a focal length rescales its own parameters.
   static inline void Rescale(double scale_x,
                              double scale_y,
                              std::vector<double>* params) {
-    (*params)[SphereModel::kFocalLengthIdxs[0]] *= scale_x;
-    (*params)[SphereModel::kFocalLengthIdxs[1]] *= scale_y;
-    (*params)[SphereModel::kPrincipalPointIdxs[0]] *= scale_x;
-    (*params)[SphereModel::kPrincipalPointIdxs[1]] *= scale_y;
+    if constexpr (kNumFocalParams == 2) {
+      (*params)[SphereModel::kFocalLengthIdxs[0]] *= scale_x;
+      (*params)[SphereModel::kFocalLengthIdxs[1]] *= scale_y;
+      (*params)[SphereModel::kPrincipalPointIdxs[0]] *= scale_x;
+      (*params)[SphereModel::kPrincipalPointIdxs[1]] *= scale_y;
+    } else {
+      SphereModel::Rescale(scale_x, scale_y, params->data());
+    }
   }
 };
 
@@ -253,9 +262,34 @@ struct DoubleSphereCameraModel
   SPHERA_CAMERA_MODEL_MEMBERS(sphera::DoubleSphereModel)
 };
 
-#define SPHERA_CAMERA_MODEL_CASES             \
-  CAMERA_MODEL_CASE(SphereEUCMCameraModel)    \
-  CAMERA_MODEL_CASE(UnifiedOmniCameraModel)   \
-  CAMERA_MODEL_CASE(DoubleSphereCameraModel)
+// Kannala-Brandt (OpenCV's fisheye model), id 5; replaces upstream's
+// OpenCVFisheyeCameraModel, which stops at z > 0.
+struct SphereOpenCVFisheyeCameraModel
+    : public SphereCameraModelAdapter<sphera::OpenCVFisheyeModel,
+                                      SphereOpenCVFisheyeCameraModel> {
+  SPHERA_CAMERA_MODEL_MEMBERS(sphera::OpenCVFisheyeModel)
+};
+
+// Kannala-Brandt with tangential and thin-prism terms, id 10; replaces
+// upstream's ThinPrismFisheyeCameraModel, which stops at z > 0.
+struct SphereThinPrismFisheyeCameraModel
+    : public SphereCameraModelAdapter<sphera::ThinPrismFisheyeModel,
+                                      SphereThinPrismFisheyeCameraModel> {
+  SPHERA_CAMERA_MODEL_MEMBERS(sphera::ThinPrismFisheyeModel)
+};
+
+// Scaramuzza's OCamCalib model, id 66.
+struct OCamCameraModel
+    : public SphereCameraModelAdapter<sphera::OCamModel, OCamCameraModel> {
+  SPHERA_CAMERA_MODEL_MEMBERS(sphera::OCamModel)
+};
+
+#define SPHERA_CAMERA_MODEL_CASES                     \
+  CAMERA_MODEL_CASE(SphereOpenCVFisheyeCameraModel)    \
+  CAMERA_MODEL_CASE(SphereThinPrismFisheyeCameraModel) \
+  CAMERA_MODEL_CASE(SphereEUCMCameraModel)             \
+  CAMERA_MODEL_CASE(UnifiedOmniCameraModel)            \
+  CAMERA_MODEL_CASE(DoubleSphereCameraModel)           \
+  CAMERA_MODEL_CASE(OCamCameraModel)
 
 }  // namespace colmap

@@ -1,7 +1,8 @@
 // SPHERA's spherical fisheye models seen through COLMAP 4.x's own camera API:
 // ids and names as files store them, rays beyond a hemisphere in both
 // directions, the analytic Jacobian that bundle adjustment uses, rescaling,
-// parameter checks and the pixel scale of reprojection errors.
+// parameter checks and the pixel scale of reprojection errors; upstream's
+// OPENCV_FISHEYE and THIN_PRISM_FISHEYE pixels in front of the image plane.
 #include "colmap/estimators/cost_functions/reprojection_error.h"
 #include "colmap/scene/camera.h"
 #include "colmap/scene/projection.h"
@@ -25,6 +26,8 @@ struct ModelCase {
   // Largest angle from the optical axis (+z) sampled; beyond pi/2 the rays
   // point behind the image plane.
   double max_angle_from_axis;
+  // fx = fy (0: a model without a focal length).
+  double focal_length = 300;
 };
 
 std::vector<ModelCase> SphereModelCases() {
@@ -35,6 +38,21 @@ std::vector<ModelCase> SphereModelCases() {
        {300, 300, 500, 400, 1.1, -0.02, 0.005, 0.0005, -0.0005},
        95.0 / 180.0 * kPi},
       {"DOUBLE_SPHERE", 65, {300, 300, 500, 400, -0.2, 0.6}, 100.0 / 180.0 * kPi},
+      {"OPENCV_FISHEYE",
+       5,
+       {300, 300, 500, 400, 0.02, -0.003, 0.0004, -0.00002},
+       100.0 / 180.0 * kPi},
+      {"THIN_PRISM_FISHEYE",
+       10,
+       {300, 300, 500, 400, 0.02, -0.003, 0.0005, -0.0003, 0.0004, -0.00002,
+        0.0004, -0.0002},
+       100.0 / 180.0 * kPi},
+      // Folds at 111 degrees from the axis.
+      {"OCAM",
+       66,
+       {500, 400, 1, 0, 0, -300, 1.25e-3, -6e-7, 0},
+       100.0 / 180.0 * kPi,
+       0},
   };
 }
 
@@ -70,11 +88,14 @@ TEST_P(SphereCameraModel, IdNameAndTaxonomy) {
   EXPECT_TRUE(camera.IsSpherical());
   EXPECT_FALSE(camera.IsPerspective());
   EXPECT_FALSE(camera.IsPerspectivePinhole());
-  EXPECT_EQ(camera.FocalLengthIdxs().size(), 2u);
+  EXPECT_FALSE(camera.IsPerspectiveFisheye());
+  const size_t num_focal = model_case.focal_length > 0 ? 2 : 0;
+  EXPECT_EQ(camera.FocalLengthIdxs().size(), num_focal);
   EXPECT_EQ(camera.PrincipalPointIdxs().size(), 2u);
-  EXPECT_EQ(camera.ExtraParamsIdxs().size(), model_case.params.size() - 4);
+  EXPECT_EQ(camera.ExtraParamsIdxs().size(),
+            model_case.params.size() - 2 - num_focal);
   EXPECT_TRUE(camera.MetaDataParamsIdxs().empty());
-  EXPECT_DOUBLE_EQ(camera.MeanFocalLength(), 300.0);
+  EXPECT_DOUBLE_EQ(camera.MeanFocalLength(), model_case.focal_length);
   EXPECT_FALSE(camera.HasBogusParams(0.1, 10, 1));
 }
 
@@ -150,12 +171,23 @@ TEST_P(SphereCameraModel, BundleAdjustmentCostIsThePixelResidual) {
   EXPECT_NEAR(residuals[1], 0.25, 1e-9);
 }
 
-TEST_P(SphereCameraModel, RescaleScalesFocalAndPrincipalPointOnly) {
+TEST_P(SphereCameraModel, RescaleScalesEveryPixel) {
   const ModelCase& model_case = GetParam();
-  Camera camera = MakeCamera(model_case);
+  const Camera original = MakeCamera(model_case);
+  Camera camera = original;
   camera.Rescale(0.5);
   EXPECT_EQ(camera.width, 500u);
   EXPECT_EQ(camera.height, 400u);
+  for (const Eigen::Vector3d& ray : {Eigen::Vector3d(0.1, -0.2, 1),
+                                     Eigen::Vector3d(1, 0.5, -0.1)}) {
+    EXPECT_LT((*camera.ImgFromCam(ray) - 0.5 * *original.ImgFromCam(ray))
+                  .norm(),
+              1e-7);
+  }
+  if (model_case.focal_length == 0) {
+    return;
+  }
+  // Focal length and principal point only.
   EXPECT_DOUBLE_EQ(camera.params[0], 150);
   EXPECT_DOUBLE_EQ(camera.params[1], 150);
   EXPECT_DOUBLE_EQ(camera.params[2], 250);
@@ -199,6 +231,49 @@ TEST(SphereCameraModels, BogusParametersAreReported) {
   camera = Camera::CreateFromModelName(1, "UNIFIED_OMNI", 300, 1000, 800);
   camera.params[0] = -300;
   EXPECT_TRUE(camera.HasBogusParams(0.1, 10, 1));
+}
+
+// In front of the image plane SPHERA's OPENCV_FISHEYE and THIN_PRISM_FISHEYE
+// are upstream's models (whose structs models.h still holds): the same pixel
+// of every ray and the same normalized point of every pixel.
+template <typename UpstreamModel>
+void ExpectUpstreamInFront(const std::vector<double>& params) {
+  const CameraModelId model_id = UpstreamModel::model_id;
+  EXPECT_TRUE(CameraModelIsSpherical(model_id));
+  for (double polar = 0; polar < 85.0 / 180 * kPi; polar += 5.0 / 180 * kPi) {
+    for (double azimuth = -kPi; azimuth < kPi; azimuth += kPi / 7) {
+      const Eigen::Vector3d ray(std::sin(polar) * std::cos(azimuth),
+                                std::sin(polar) * std::sin(azimuth),
+                                std::cos(polar));
+      double x, y, upstream_x, upstream_y;
+      ASSERT_TRUE(UpstreamModel::ImgFromCam(params.data(), ray.x(), ray.y(),
+                                            ray.z(), &upstream_x, &upstream_y));
+      const std::optional<Eigen::Vector2d> pixel =
+          CameraModelImgFromCam(model_id, params, ray);
+      ASSERT_TRUE(pixel.has_value()) << polar;
+      x = pixel->x();
+      y = pixel->y();
+      EXPECT_NEAR(x, upstream_x, 1e-8) << polar;
+      EXPECT_NEAR(y, upstream_y, 1e-8) << polar;
+      double u, v;
+      ASSERT_TRUE(UpstreamModel::CamFromImg(params.data(), x, y, &u, &v));
+      const std::optional<Eigen::Vector2d> normalized =
+          CameraModelCamFromImg(model_id, params, Eigen::Vector2d(x, y));
+      ASSERT_TRUE(normalized.has_value()) << polar;
+      EXPECT_NEAR(normalized->x(), u, 1e-8 * (1 + std::abs(u))) << polar;
+      EXPECT_NEAR(normalized->y(), v, 1e-8 * (1 + std::abs(v))) << polar;
+    }
+  }
+  EXPECT_EQ(CameraModelParamsInfo(model_id),
+            UpstreamModel::InitializeParamsInfo());
+}
+
+TEST(SphereCameraModels, KannalaBrandtIsUpstreamsInFrontOfTheImagePlane) {
+  ExpectUpstreamInFront<OpenCVFisheyeCameraModel>(
+      {300, 310, 500, 400, 0.02, -0.003, 0.0004, -0.00002});
+  ExpectUpstreamInFront<ThinPrismFisheyeCameraModel>(
+      {300, 310, 500, 400, 0.02, -0.003, 0.0005, -0.0003, 0.0004, -0.00002,
+       0.0004, -0.0002});
 }
 
 TEST(SphereCameraModels, UpstreamIdsKeepTheirNames) {
