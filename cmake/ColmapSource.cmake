@@ -333,29 +333,28 @@ function(sphera_unpack_dependency archive source_dir)
 endfunction()
 
 # Finds the source of `dep` (POSELIB or FAISS) without unpacking anything:
-# sets SPHERA_<dep>_SOURCE_DIR (where its tree is or will be) and
-# SPHERA_<dep>_ARCHIVE (what to unpack there, "" when it is there already) in
-# the caller's scope, or appends to the list `errors_var` why it cannot be
-# had. The tarball of the snapshot comes first, then upstream's archive.
+# sets SPHERA_<dep>_SOURCE_DIR (where its tree is or will be),
+# SPHERA_<dep>_ARCHIVE (what to unpack there, "" when it is there already)
+# and SPHERA_<dep>_SOURCE_ID (which archive the tree comes from) in the
+# caller's scope, or appends to the list `errors_var` why it cannot be had.
+# The tarball of the snapshot comes first, then upstream's archive. Either is
+# unpacked to the same folder, colmap4-deps/<label>, whose stamp names the
+# archive: the objects' paths do not depend on where a source came from, so
+# that ccache serves a build from the mirrors of the public hosts with the
+# objects of a build from the tarballs, and the other way round.
 function(sphera_find_dependency dep errors_var)
-  set(deps_dir "${CMAKE_BINARY_DIR}/colmap4-deps")
+  set(source_dir "${CMAKE_BINARY_DIR}/colmap4-deps/${SPHERA_${dep}_LABEL}")
   set(name ${SPHERA_${dep}_NAME})
-  set(snapshot_dir "${deps_dir}/${name}")
   string(TOLOWER "${SPHERA_${dep}_URL_SHA256}" url_sha256)
-  string(SUBSTRING "${url_sha256}" 0 12 url_sha256_prefix)
-  set(online_dir "${deps_dir}/${SPHERA_${dep}_LABEL}-${url_sha256_prefix}")
   set(archive "")
-  if(EXISTS "${snapshot_dir}/CMakeLists.txt")
-    set(source_dir "${snapshot_dir}")
+  sphera_find_tarball(${name} ${SPHERA_${dep}_SHA256} SPHERA_${dep}_TARBALL
+                      archive searched)
+  if(archive)
+    set(source_id "${name}.tar.gz ${SPHERA_${dep}_SHA256}")
   else()
-    sphera_find_tarball(${name} ${SPHERA_${dep}_SHA256} SPHERA_${dep}_TARBALL
-                        archive searched)
-    if(archive)
-      set(source_dir "${snapshot_dir}")
-    elseif(EXISTS "${online_dir}/CMakeLists.txt")
-      set(source_dir "${online_dir}")
-    else()
-      set(source_dir "${online_dir}")
+    set(source_id "${SPHERA_${dep}_URL} ${url_sha256}")
+    sphera_read_dependency_stamp("${source_dir}" unpacked_id)
+    if(NOT unpacked_id STREQUAL source_id)
       sphera_download_dependency(${dep} archive error)
       if(NOT archive)
         set(errors "${${errors_var}}")
@@ -373,18 +372,36 @@ function(sphera_find_dependency dep errors_var)
   endif()
   set(SPHERA_${dep}_SOURCE_DIR "${source_dir}" PARENT_SCOPE)
   set(SPHERA_${dep}_ARCHIVE "${archive}" PARENT_SCOPE)
+  set(SPHERA_${dep}_SOURCE_ID "${source_id}" PARENT_SCOPE)
 endfunction()
 
-# PoseLib and faiss, unpacked once into the build tree (a stable path, so that
-# ccache hits across clones) and consumed by COLMAP's FetchContent without a
-# network.
+# Sets `out_var` to the archive a dependency's tree in `source_dir` was
+# unpacked from ("" when there is no complete tree).
+function(sphera_read_dependency_stamp source_dir out_var)
+  set(id "")
+  if(EXISTS "${source_dir}.stamp" AND EXISTS "${source_dir}/CMakeLists.txt")
+    file(READ "${source_dir}.stamp" id)
+    string(STRIP "${id}" id)
+  endif()
+  set(${out_var} "${id}" PARENT_SCOPE)
+endfunction()
+
+# PoseLib and faiss, unpacked into the build tree (a stable path, so that
+# ccache hits across clones and sources) unless the tree there comes from the
+# same archive, and consumed by COLMAP's FetchContent without a network.
 function(sphera_unpack_colmap_dependencies)
   foreach(dep POSELIB FAISS)
-    if(SPHERA_${dep}_ARCHIVE)
-      sphera_unpack_dependency("${SPHERA_${dep}_ARCHIVE}" "${SPHERA_${dep}_SOURCE_DIR}")
+    set(source_dir "${SPHERA_${dep}_SOURCE_DIR}")
+    sphera_read_dependency_stamp("${source_dir}" unpacked_id)
+    if(NOT unpacked_id STREQUAL SPHERA_${dep}_SOURCE_ID)
+      file(REMOVE "${source_dir}.stamp")
+      file(REMOVE_RECURSE "${source_dir}")
+      sphera_unpack_dependency("${SPHERA_${dep}_ARCHIVE}" "${source_dir}")
+      file(WRITE "${source_dir}.stamp" "${SPHERA_${dep}_SOURCE_ID}\n")
     endif()
-    message(STATUS "${SPHERA_${dep}_LABEL} source: ${SPHERA_${dep}_SOURCE_DIR}")
-    set(FETCHCONTENT_SOURCE_DIR_${dep} "${SPHERA_${dep}_SOURCE_DIR}" CACHE PATH "" FORCE)
+    message(STATUS "${SPHERA_${dep}_LABEL} source: ${source_dir} "
+                   "(${SPHERA_${dep}_SOURCE_ID})")
+    set(FETCHCONTENT_SOURCE_DIR_${dep} "${source_dir}" CACHE PATH "" FORCE)
   endforeach()
   set(FETCHCONTENT_FULLY_DISCONNECTED ON CACHE BOOL "" FORCE)
   set(ONNX_ENABLED OFF CACHE BOOL "" FORCE)

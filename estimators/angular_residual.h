@@ -110,13 +110,6 @@ inline void AngularLogResidual(const T* u, const T* v, T* residual) {
   LogMapResidualFromComponents(a, b, c, residual);
 }
 
-inline Eigen::Vector2d AngularLogResidual(const Eigen::Vector3d& u,
-                                          const Eigen::Vector3d& v) {
-  Eigen::Vector2d r;
-  AngularLogResidual(u.data(), v.data(), r.data());
-  return r;
-}
-
 // The same residual in doubles with its analytic Jacobian dr/dv (2 x 3,
 // row-major; nullptr skips it), u fixed.  With g = theta / s and
 // n2 = s^2 + c^2 = |v|^2:

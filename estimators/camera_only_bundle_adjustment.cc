@@ -24,12 +24,6 @@ Eigen::Matrix3x4d CameraPose::Matrix() const {
   return P;
 }
 
-double ReliablePoint::MaxError() const {
-  double m = 0;
-  for (const double e : errors_rad) m = std::max(m, e);
-  return m;
-}
-
 const char* CameraOnlyBAStatusName(CameraOnlyBAStatus status) {
   switch (status) {
     case CameraOnlyBAStatus::kSuccess:

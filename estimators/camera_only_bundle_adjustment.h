@@ -96,7 +96,6 @@ struct ReliablePoint {
   int track_idx = -1;
   Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
   std::vector<double> errors_rad;
-  double MaxError() const;
 };
 
 enum class CameraOnlyBAStatus {

@@ -44,8 +44,9 @@ Lenses that lie like real ones (the real-lenses issue):
   --realistic     sphera_render's sensor effects (cropped circles, housing,
                   vignetting, flare, per-lens exposure and white balance,
                   noise, JPEG)
-  --fit_model M   the rig starts from model M (EUCM, DOUBLE_SPHERE or
-                  UNIFIED_OMNI) with rough intrinsics from each lens's image
+  --fit_model M   the rig starts from model M (EUCM, DOUBLE_SPHERE,
+                  UNIFIED_OMNI or OPENCV_FISHEYE, the drawn lenses' own
+                  family) with rough intrinsics from each lens's image
                   circle and field of view (principal point at the image
                   centre, focal length so that the field's edge lands on the
                   circle) and zero offsets, and self-calibrates
@@ -153,10 +154,14 @@ def rough_start(model, width, height, circle_radius, half_field_deg):
     point at the image centre and the focal length that puts the edge of
     the field on the image circle, the model's generic fisheye shape (EUCM
     alpha 0.5, beta 1; DOUBLE_SPHERE xi 0, alpha 0.5: both r = 2 f tan(t/2);
-    UNIFIED_OMNI xi 1 without distortion: r = f tan(t/2))."""
+    UNIFIED_OMNI xi 1 without distortion: r = f tan(t/2); OPENCV_FISHEYE
+    without distortion: the equidistant r = f t)."""
     import math
     half_tan = math.tan(math.radians(half_field_deg) / 2)
     cx, cy = width / 2.0, height / 2.0
+    if model == "OPENCV_FISHEYE":
+        f = circle_radius / math.radians(half_field_deg)
+        return [f, f, cx, cy, 0.0, 0.0, 0.0, 0.0]
     if model == "UNIFIED_OMNI":
         f = circle_radius / half_tan
         return [f, f, cx, cy, 1.0, 0.0, 0.0, 0.0, 0.0]
@@ -166,7 +171,7 @@ def rough_start(model, width, height, circle_radius, half_field_deg):
     if model == "DOUBLE_SPHERE":
         return [f, f, cx, cy, 0.0, 0.5]
     raise ValueError(f"--fit_model {model}: one of EUCM, DOUBLE_SPHERE, "
-                     "UNIFIED_OMNI")
+                     "UNIFIED_OMNI, OPENCV_FISHEYE")
 
 
 def fitted_rig_config(scene, path, model, half_field_deg):
@@ -458,7 +463,8 @@ def main():
                         help="sphera_render's sensor effects")
     parser.add_argument("--fit_model", default="",
                         help="the rig starts from this model's rough "
-                             "parameters (EUCM, DOUBLE_SPHERE, UNIFIED_OMNI)")
+                             "parameters (EUCM, DOUBLE_SPHERE, UNIFIED_OMNI, "
+                             "OPENCV_FISHEYE)")
     parser.add_argument("--supersample", type=int, default=2,
                         help="rays per pixel side of the renders")
     parser.add_argument("--output", default=os.path.join(REPO, "build",

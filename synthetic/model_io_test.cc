@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "camera_models/registry.h"
+#include "synthetic/file_formats.h"
 
 namespace sphera {
 namespace synthetic {
@@ -68,10 +69,10 @@ TEST(Dataset, WritesColmapTextGroundTruthAtomically) {
     EXPECT_TRUE(fs::exists(dir / file)) << file;
   }
   EXPECT_EQ(cv::imread((dir / "images/b.png").string()).cols, 64);
-  cv::Mat depth;
-  ASSERT_TRUE(ReadDepthMap((dir / "depth/c.jpg.depth.bin").string(), &depth));
-  EXPECT_EQ(depth.cols, 40);
-  EXPECT_EQ(depth.rows, 30);
+  RangeMap depth;
+  ASSERT_EQ(ReadRangeMap((dir / "depth/c.jpg.depth.bin").string(), &depth), "");
+  EXPECT_EQ(depth.width, 40);
+  EXPECT_EQ(depth.height, 30);
 
   // Identical intrinsics share a camera.
   const std::vector<std::string> camera_lines = DataLines(dir / "sparse_gt/cameras.txt");

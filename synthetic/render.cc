@@ -295,12 +295,5 @@ bool WriteDepthMap(const std::string& path, const cv::Mat& depth) {
   return WriteRangeMap(path, map);
 }
 
-bool ReadDepthMap(const std::string& path, cv::Mat* depth) {
-  RangeMap map;
-  if (!ReadRangeMap(path, &map).empty()) return false;
-  cv::Mat(map.height, map.width, CV_32F, map.ranges.data()).copyTo(*depth);
-  return true;
-}
-
 }  // namespace synthetic
 }  // namespace sphera

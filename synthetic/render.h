@@ -100,10 +100,10 @@ RenderedImage Render(const Scene& scene, const VirtualCamera& camera,
 // and clamped to [0, 255].
 cv::Mat ToEightBit(const cv::Mat& radiance);
 
-// A rendered range map as a CV_32F image, in the range-map file format
-// (synthetic/file_formats.h); false where the file cannot be written or read.
+// Writes a rendered range map (a CV_32F image) in the range-map file format
+// of synthetic/file_formats.h (read with sphera::ReadRangeMap); false where
+// the file cannot be written.
 bool WriteDepthMap(const std::string& path, const cv::Mat& depth);
-bool ReadDepthMap(const std::string& path, cv::Mat* depth);
 
 }  // namespace synthetic
 }  // namespace sphera

@@ -143,12 +143,6 @@ std::string SceneOptions::Check() const {
   return error.str();
 }
 
-Eigen::Vector3d Face::Normal() const {
-  Eigen::Vector3d n = Eigen::Vector3d::Zero();
-  n[axis] = sign;
-  return n;
-}
-
 double Face::Area() const { return (max_uv - min_uv).prod(); }
 
 Eigen::Vector2d Face::UV(const Eigen::Vector3d& point) const {

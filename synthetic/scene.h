@@ -62,7 +62,6 @@ struct Face {
   Eigen::Vector2d min_uv = Eigen::Vector2d::Zero();
   Eigen::Vector2d max_uv = Eigen::Vector2d::Zero();
 
-  Eigen::Vector3d Normal() const;
   double Area() const;
   // Face coordinates of a point on the face plane.
   Eigen::Vector2d UV(const Eigen::Vector3d& point) const;
@@ -86,7 +85,6 @@ class Scene {
 
   const SceneOptions& Options() const { return options_; }
   const std::vector<Face>& Faces() const { return faces_; }
-  const std::vector<AlignedBox>& Boxes() const { return boxes_; }
 
   // Nearest front-facing surface along origin + t * direction, t > 0.
   // `direction` must be unit length so that `range` is metric.

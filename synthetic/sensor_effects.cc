@@ -80,11 +80,6 @@ SensorEffects SensorEffects::Realistic() {
   return effects;
 }
 
-bool SensorEffects::ChangesPixels() const {
-  return circle_radius > 0 || housing > 0 || surround > 0 || vignetting > 0 || flare > 0 ||
-         exposure_jitter > 0 || white_balance_jitter > 0 || noise_sigma > 0;
-}
-
 std::string SensorEffects::Check() const {
   struct Range {
     const char* name;

@@ -76,8 +76,6 @@ struct SensorEffects {
   // vignetting, flare, exposure and white-balance jitter, noise 2, JPEG 90.
   static SensorEffects Realistic();
 
-  // True if any effect changes pixels (everything but jpeg_quality and seed).
-  bool ChangesPixels() const;
   // Empty if valid, else a message that starts with the offending field's name.
   std::string Check() const;
 };

@@ -178,8 +178,13 @@ class ColmapFetchTest(TempDirTestCase):
         result, build_dir = self.configure("build", self.mirror_args())
         self.assertEqual(result.returncode, 0, result.stdout)
         self.assertTrue(os.path.exists(os.path.join(build_dir, "build.ninja")))
-        self.assertTrue(glob.glob(os.path.join(
-            build_dir, "colmap4-deps", "PoseLib-*", "CMakeLists.txt")))
+        # Unpacked where a build from the tarball unpacks it (one path for
+        # ccache), its stamp naming the archive it came from.
+        deps = os.path.join(build_dir, "colmap4-deps")
+        self.assertTrue(os.path.exists(
+            os.path.join(deps, "PoseLib", "CMakeLists.txt")))
+        with open(os.path.join(deps, "PoseLib.stamp")) as stamp:
+            self.assertIn(POSELIB_TARBALL_SHA256.lower(), stamp.read())
 
     def test_no_source_names_each_one_once(self):
         gone = "file://" + self.path("gone")

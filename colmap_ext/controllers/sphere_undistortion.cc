@@ -401,10 +401,10 @@ Eigen::Matrix3d FaceFromCamRotation(const CubeFace face) {
   return rotation;
 }
 
-Rigid3d FaceFromWorld(const Rigid3d& cam_from_world, const CubeFace face) {
-  const Rigid3d face_from_cam(Eigen::Quaterniond(FaceFromCamRotation(face)),
-                              Eigen::Vector3d::Zero());
-  return face_from_cam * cam_from_world;
+Rigid3d ViewFromWorld(const Eigen::Matrix3d& view_from_cam,
+                      const Rigid3d& cam_from_world) {
+  return Rigid3d(Eigen::Quaterniond(view_from_cam), Eigen::Vector3d::Zero()) *
+         cam_from_world;
 }
 
 Camera MakeFaceCamera(const int face_size, const double fov_deg) {
@@ -801,9 +801,7 @@ SphereExportSummary ExportPerspectiveWorkspace(
       view_image.SetName(view.name);
       view_image.SetCameraId(camera_it->second);
       const Rigid3d view_from_world =
-          Rigid3d(Eigen::Quaterniond(view.view_from_cam),
-                  Eigen::Vector3d::Zero()) *
-          cam_from_world;
+          ViewFromWorld(view.view_from_cam, cam_from_world);
       std::vector<Point2D> view_points2D;
       for (size_t k = 0; k < points2D.size(); ++k) {
         if (!rays[k].has_value() || !NearestLens(other_axes, *rays[k])) {

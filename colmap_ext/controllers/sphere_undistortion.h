@@ -127,8 +127,10 @@ const char* SphereImageFormatExtension(SphereImageFormat image_format);
 // z forward in the face image).
 Eigen::Matrix3d FaceFromCamRotation(CubeFace face);
 
-// face_from_world = face_from_cam * cam_from_world (same camera centre).
-Rigid3d FaceFromWorld(const Rigid3d& cam_from_world, CubeFace face);
+// view_from_world = view_from_cam * cam_from_world: a view turned from the
+// camera about its centre (a cube face, a lens's own direction).
+Rigid3d ViewFromWorld(const Eigen::Matrix3d& view_from_cam,
+                      const Rigid3d& cam_from_world);
 
 // PINHOLE face camera: f = size/2 / tan(fov/2), c = size/2.
 Camera MakeFaceCamera(int face_size, double fov_deg);

@@ -110,7 +110,8 @@ TEST(SphereUndistorter, FacePoseComposition) {
     for (const CubeFace face :
          {CubeFace::kFront, CubeFace::kRight, CubeFace::kBack,
           CubeFace::kLeft, CubeFace::kUp, CubeFace::kDown}) {
-      const Rigid3d face_from_world = FaceFromWorld(cam_from_world, face);
+      const Rigid3d face_from_world =
+          ViewFromWorld(FaceFromCamRotation(face), cam_from_world);
       // Same centre.
       const Eigen::Vector3d face_center =
           -(face_from_world.rotation().inverse() *
@@ -186,7 +187,8 @@ TEST(SphereUndistorter, FaceProjectionMatchesPanoramaRemap) {
     const Eigen::Vector2d pano_pixel = *projected_pano_pixel;
     int num_faces = 0;
     for (const CubeFace face : faces) {
-      const Rigid3d face_from_world = FaceFromWorld(cam_from_world, face);
+      const Rigid3d face_from_world =
+          ViewFromWorld(FaceFromCamRotation(face), cam_from_world);
       const std::optional<Eigen::Vector2d> projected_face_pixel =
           face_camera.ImgFromCam(face_from_world * point);
       if (!projected_face_pixel.has_value()) {

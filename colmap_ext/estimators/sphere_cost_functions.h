@@ -28,9 +28,9 @@
 // AngularReprojErrorConstantPoseCostFunction, tested against the autodiff
 // AngularReprojErrorCostFunctor; mapping a 360-degree set with the angular
 // residual then costs no more than with the pixel one. The rig costs
-// (upstream's are autodiff) are analytic too, against the autodiff
-// AngularRigReprojErrorCostFunctor: a lens of a rig has 23 to 26 parameters,
-// and autodiff of all of them dominated the mapping of rigs.
+// (upstream's are autodiff) are analytic too, tested against an autodiff
+// reference: a lens of a rig has 23 to 26 parameters, and autodiff of all of
+// them dominated the mapping of rigs.
 #pragma once
 
 #include "colmap/estimators/cost_functions/quaternion_utils.h"
@@ -345,41 +345,6 @@ class AngularReprojErrorConstantPoint3DCostFunctor
   const AngularReprojErrorCostFunctor<CameraModel> reproj_cost_;
 };
 
-template <typename CameraModel>
-class AngularRigReprojErrorCostFunctor
-    : public AutoDiffCostFunctor<AngularRigReprojErrorCostFunctor<CameraModel>,
-                                 2,
-                                 3,
-                                 7,
-                                 7,
-                                 CameraModel::num_params> {
- public:
-  AngularRigReprojErrorCostFunctor(const double* camera_params,
-                                   const Eigen::Vector2d& point2D)
-      : point2D_(point2D),
-        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)) {}
-
-  template <typename T>
-  bool operator()(const T* const point3D_in_world,
-                  const T* const cam_from_rig,
-                  const T* const rig_from_world,
-                  const T* const camera_params,
-                  T* residuals) const {
-    const Eigen::Matrix<T, 3, 1> point3D_in_cam =
-        EigenQuaternionMap<T>(cam_from_rig) *
-            (EigenQuaternionMap<T>(rig_from_world) *
-                 EigenVector3Map<T>(point3D_in_world) +
-             EigenVector3Map<T>(rig_from_world + 4)) +
-        EigenVector3Map<T>(cam_from_rig + 4);
-    return AngularReprojResidual<CameraModel>(
-        camera_params, point2D_, point3D_in_cam, pixels_per_radian_, residuals);
-  }
-
- private:
-  const Eigen::Vector2d point2D_;
-  const double pixels_per_radian_;
-};
-
 // The residual of a lens of a rig with analytic derivatives: the point goes
 // through rig_from_world, then cam_from_rig, and the chain rule joins the
 // rotations' Jacobians to the residual's. Any Jacobian may be nullptr (a
@@ -446,9 +411,10 @@ bool AngularRigResidualWithJacobians(const Eigen::Vector2d& point2D,
   return true;
 }
 
-// AngularRigReprojErrorCostFunctor with analytic Jacobians: what bundle
-// adjustment uses for a lens of a rig (every observation of a non-reference
-// lens), the autodiff functor being its reference in the tests.
+// The angular residual of a lens of a rig with analytic Jacobians: what
+// bundle adjustment uses for a lens of a rig (every observation of a
+// non-reference lens); the tests hold it against autodiff of the same
+// residual.
 template <typename CameraModel>
 class AngularRigReprojErrorCostFunction
     : public ceres::

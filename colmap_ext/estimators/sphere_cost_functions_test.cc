@@ -25,6 +25,43 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// The autodiff reference of AngularRigReprojErrorCostFunction: the same
+// residual (rig_from_world, then cam_from_rig), differentiated by Ceres.
+template <typename CameraModel>
+class AngularRigReprojErrorCostFunctor
+    : public AutoDiffCostFunctor<AngularRigReprojErrorCostFunctor<CameraModel>,
+                                 2,
+                                 3,
+                                 7,
+                                 7,
+                                 CameraModel::num_params> {
+ public:
+  AngularRigReprojErrorCostFunctor(const double* camera_params,
+                                   const Eigen::Vector2d& point2D)
+      : point2D_(point2D),
+        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)) {}
+
+  template <typename T>
+  bool operator()(const T* const point3D_in_world,
+                  const T* const cam_from_rig,
+                  const T* const rig_from_world,
+                  const T* const camera_params,
+                  T* residuals) const {
+    const Eigen::Matrix<T, 3, 1> point3D_in_cam =
+        EigenQuaternionMap<T>(cam_from_rig) *
+            (EigenQuaternionMap<T>(rig_from_world) *
+                 EigenVector3Map<T>(point3D_in_world) +
+             EigenVector3Map<T>(rig_from_world + 4)) +
+        EigenVector3Map<T>(cam_from_rig + 4);
+    return AngularReprojResidual<CameraModel>(
+        camera_params, point2D_, point3D_in_cam, pixels_per_radian_, residuals);
+  }
+
+ private:
+  const Eigen::Vector2d point2D_;
+  const double pixels_per_radian_;
+};
+
 struct CostCase {
   std::string model;
   std::vector<double> params;

@@ -952,24 +952,6 @@ LensImage CutImageCircle(const cv::Mat& lens_image, const ImageCircle& circle) {
   return lens;
 }
 
-std::array<LensImage, 2> SplitDualFisheye(
-    const cv::Mat& raw, const std::array<ImageCircle, 2>& circles) {
-  if (const std::string error = DualFisheyeLayoutError(raw); !error.empty()) {
-    throw std::invalid_argument(error);
-  }
-  const std::array<cv::Mat, 2> lens_images = LensImagesOfRawFrame(raw);
-  std::array<LensImage, 2> lenses;
-  for (int lens = 0; lens < 2; ++lens) {
-    try {
-      lenses[lens] = CutImageCircle(lens_images[lens], circles[lens]);
-    } catch (const std::invalid_argument& error) {
-      throw std::invalid_argument("lens " + std::to_string(lens) + ": " +
-                                  error.what());
-    }
-  }
-  return lenses;
-}
-
 std::string ParseImageCircles(const std::string& text,
                               std::array<ImageCircle, 2>* circles) {
   const std::string expected =

@@ -162,12 +162,6 @@ ImageCircle MedianImageCircle(const std::vector<ImageCircle>& circles);
 // LensImageError or CIRCLE fails ImageCircleError.
 LensImage CutImageCircle(const cv::Mat& lens_image, const ImageCircle& circle);
 
-// Splits RAW into its two lens images with CIRCLES[i] the image circle of
-// lens i (CutImageCircle). Throws std::invalid_argument when RAW fails
-// DualFisheyeLayoutError or a circle fails ImageCircleError.
-std::array<LensImage, 2> SplitDualFisheye(
-    const cv::Mat& raw, const std::array<ImageCircle, 2>& circles);
-
 // Parses "cx,cy,r;cx,cy,r" (lens0; lens1). Returns "" and sets *CIRCLES, or
 // why TEXT is not two circles.
 std::string ParseImageCircles(const std::string& text,

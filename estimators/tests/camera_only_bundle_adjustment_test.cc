@@ -1,5 +1,6 @@
 #include "estimators/camera_only_bundle_adjustment.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
@@ -192,7 +193,9 @@ TEST(CameraOnlyBundleAdjustment, TauExcludesOutliers) {
   int num_outliers_kept = 0;
   for (const auto& p : result.points) {
     num_outliers_kept += outlier_tracks.count(p.track_idx);
-    EXPECT_LE(p.MaxError(), 3 * kRadPerPx);
+    ASSERT_FALSE(p.errors_rad.empty());
+    EXPECT_LE(*std::max_element(p.errors_rad.begin(), p.errors_rad.end()),
+              3 * kRadPerPx);
   }
   EXPECT_EQ(num_outliers_kept, 0);
   EXPECT_GT(result.points.size(), 0.8 * (scene.tracks.size() -
