@@ -2,10 +2,12 @@
 
 #include "colmap/scene/camera.h"
 #include "colmap/sensor/models.h"
+#include "colmap/util/file.h"
 #include "colmap/util/logging.h"
 #include "colmap/util/string.h"
 #include "colmap_ext/image/image_file_structure.h"
 #include "colmap_ext/scene/camera_params_error.h"
+#include "colmap_ext/scene/unused_cameras.h"
 
 #include <algorithm>
 #include <array>
@@ -91,6 +93,46 @@ std::string TooSmallImageError(const int width, const int height) {
         "%dx%d pixels: too small to extract features from", width, height);
   }
   return "";
+}
+
+bool CheckImageReaderCameraOptions(const std::string& camera_model,
+                                   const std::string& camera_params) {
+  const std::string error =
+      ImageReaderCameraOptionsError(camera_model, camera_params);
+  if (!error.empty()) {
+    LOG(ERROR) << error;
+  }
+  return error.empty();
+}
+
+bool PrepareFeatureExtraction(const std::filesystem::path& database_path,
+                              const ImageReaderOptions& options) {
+  if (!ExistsDir(options.image_path)) {
+    LOG(ERROR) << "image_path: " << options.image_path << " is not a directory";
+    return false;
+  }
+  RemoveCamerasOfInterruptedExtraction(database_path,
+                                       options.existing_camera_id);
+  ClearImageErrors();
+  return true;
+}
+
+bool ReadImageOrReport(const std::string& image_name,
+                       const std::filesystem::path& path,
+                       const bool as_rgb,
+                       Bitmap* bitmap) {
+  std::string error = ImageFileError(path);
+  if (error.empty()) {
+    if (!bitmap->Read(path, as_rgb)) {
+      return false;  // The reader's status names the image.
+    }
+    error = TooSmallImageError(bitmap->Width(), bitmap->Height());
+  }
+  if (!error.empty()) {
+    ReportImageError(image_name, error);
+    return false;
+  }
+  return true;
 }
 
 int ImageErrorsExitStatus() {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "colmap/controllers/image_reader.h"
+#include "colmap/sensor/bitmap.h"
 
 #include <filesystem>
 #include <string>
@@ -18,6 +19,26 @@ namespace colmap {
 // as not finite rather than as unparsable.
 std::string ImageReaderCameraOptionsError(const std::string& camera_model,
                                           const std::string& camera_params);
+
+// Before feature extraction from `options.image_path` into the database at
+// `database_path`: false (logged, naming the option) when the image path is
+// not a folder; otherwise removes the cameras an interrupted extraction left
+// (RemoveCamerasOfInterruptedExtraction) and clears the image errors.
+bool PrepareFeatureExtraction(const std::filesystem::path& database_path,
+                              const ImageReaderOptions& options);
+
+// The image reader's read of an image: false, with the reason reported for
+// `image_name`, when the file cannot be read whole (ImageFileError), the
+// decoder fails, or the image is too small (TooSmallImageError).
+bool ReadImageOrReport(const std::string& image_name,
+                       const std::filesystem::path& path,
+                       bool as_rgb,
+                       Bitmap* bitmap);
+
+// ImageReaderCameraOptionsError as a check: false, with the message logged,
+// when the options are bad.
+bool CheckImageReaderCameraOptions(const std::string& camera_model,
+                                   const std::string& camera_params);
 
 // Thread-safe; records "image_name: message", the first message of each
 // image only.

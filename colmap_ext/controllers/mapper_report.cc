@@ -79,9 +79,15 @@ std::vector<MapperImageReport> BuildMapperReport(
   return report;
 }
 
-void LogMapperReport(const std::vector<MapperImageReport>& report,
+void LogMapperReport(const Database& database,
                      const ReconstructionManager& reconstruction_manager,
+                     const IncrementalPipelineOptions& mapper_options,
                      const std::vector<HeldCamera>& held_cameras) {
+  const std::vector<MapperImageReport> report =
+      BuildMapperReport(database,
+                        reconstruction_manager,
+                        mapper_options.min_num_matches,
+                        mapper_options.image_names);
   size_t num_registered = 0;
   for (const MapperImageReport& entry : report) {
     if (entry.model_index >= 0) ++num_registered;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "colmap/controllers/incremental_pipeline.h"
 #include "colmap/scene/database.h"
 #include "colmap/scene/reconstruction_manager.h"
 #include "colmap_ext/scene/intrinsics_divergence.h"
@@ -38,10 +39,13 @@ std::vector<MapperImageReport> BuildMapperReport(
     const std::vector<std::string>& image_names);
 
 // Logs the models (images and points each) and every image that is in no
-// model, with its reason; a split into several models is pointed out, and
-// the cameras the mapper held (IncrementalPipeline::HeldCameras) are named.
-void LogMapperReport(const std::vector<MapperImageReport>& report,
+// model, with its reason (BuildMapperReport with the mapper's
+// min_num_matches and image list); a split into several models is pointed
+// out, and the cameras the mapper held (IncrementalPipeline::HeldCameras)
+// are named.
+void LogMapperReport(const Database& database,
                      const ReconstructionManager& reconstruction_manager,
+                     const IncrementalPipelineOptions& mapper_options,
                      const std::vector<HeldCamera>& held_cameras);
 
 }  // namespace colmap

@@ -145,7 +145,7 @@ TEST(SphereUndistorter, FaceCameraAndAutoSize) {
               1e-9);
   EXPECT_EQ(AutoFaceSize(EquirectCamera(2048), 90), 512);
   EXPECT_TRUE(IsCubeMappedModel(CameraModelId::kEquirectangular));
-  EXPECT_TRUE(IsCubeMappedModel(CameraModelId::kUnifiedOmni));
+  EXPECT_TRUE(IsCubeMappedModel(UnifiedOmniCameraModel::model_id));
   EXPECT_TRUE(IsCubeMappedModel(CameraModelId::kOpenCVFisheye));
   EXPECT_FALSE(IsCubeMappedModel(CameraModelId::kOpenCV));
   EXPECT_FALSE(IsCubeMappedModel(CameraModelId::kPinhole));
@@ -741,7 +741,7 @@ TEST(SphereUndistorter, PerFrameSharesTheDirectionsOfARigFrame) {
   for (camera_t camera_id : {1, 2}) {
     Camera camera;
     camera.camera_id = camera_id;
-    camera.model_id = CameraModelId::kDoubleSphere;
+    camera.model_id = DoubleSphereCameraModel::model_id;
     camera.width = 128;
     camera.height = 128;
     camera.params = {29.5, 29.5, 64, 64, -0.2, 0.6};

@@ -2,6 +2,7 @@
 
 #include "colmap/scene/camera.h"
 #include "colmap/sensor/models.h"
+#include "colmap/util/logging.h"
 #include "colmap_ext/scene/camera_params_error.h"
 #include "colmap/util/types.h"
 
@@ -677,6 +678,28 @@ void CheckDatabaseFile(const std::filesystem::path& path,
     return;
   }
   DatabaseChecker(path, format_version).Run();
+}
+
+std::shared_ptr<Database> OpenDatabase(
+    const std::vector<Database::Factory>& factories,
+    const std::filesystem::path& path) {
+  std::string reason = "no database factory registered";
+  for (auto it = factories.rbegin(); it != factories.rend(); ++it) {
+    try {
+      return (*it)(path);
+    } catch (const std::exception& e) {
+      reason = e.what();
+      if (std::next(it) != factories.rend()) {
+        LOG(WARNING) << "Failed to open database with registered factory, "
+                        "because: "
+                     << reason << ". Trying next registered factory.";
+      }
+    }
+  }
+  if (reason.rfind("database ", 0) != 0) {
+    reason = "database " + path.string() + ": " + reason;
+  }
+  throw std::runtime_error(reason);
 }
 
 }  // namespace colmap

@@ -2,6 +2,8 @@
 // writing, and after a matching run.
 #pragma once
 
+#include "colmap/scene/database.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -27,6 +29,13 @@ namespace colmap {
 // cost is one read of the file. A file that does not exist or is empty (a
 // new database) passes.
 void CheckDatabaseFile(const std::filesystem::path& path, int format_version);
+
+// Database::Open: the database at `path` from the last registered of
+// `factories` that opens it; when none does, throws the last one's reason,
+// prefixed with "database PATH: " unless the reason names it already.
+std::shared_ptr<Database> OpenDatabase(
+    const std::vector<Database::Factory>& factories,
+    const std::filesystem::path& path);
 
 // False for a file that does not exist or is empty: a database COLMAP is
 // about to create.

@@ -178,6 +178,39 @@ std::optional<std::string> RigFrameLenses::Add(const size_t lens_idx,
   return frame_name;
 }
 
+camera_t RigFrameLenses::ConfigureCamera(
+    const size_t lens_idx,
+    const std::optional<camera_t>& camera_id,
+    std::set<camera_t>* rig_camera_ids,
+    Database& database,
+    Reconstruction* reconstruction) {
+  const RigConfig::RigCamera& lens = config_.cameras.at(lens_idx);
+  if (!camera_id.has_value()) {
+    throw std::invalid_argument("No image has the prefix \"" +
+                                lens.image_prefix + "\" and suffix \"" +
+                                lens.image_suffix + "\" of a camera in the rig");
+  }
+  camera_t id = *camera_id;
+  if (!rig_camera_ids->insert(id).second) {
+    id = MoveToOwnCamera(lens_idx, id, database, reconstruction);
+    rig_camera_ids->insert(id);
+  }
+  if (lens.camera.has_value()) {
+    const auto copy_intrinsics = [&lens](Camera& camera) {
+      camera.model_id = lens.camera->model_id;
+      camera.params = lens.camera->params;
+      camera.has_prior_focal_length = lens.camera->has_prior_focal_length;
+    };
+    Camera database_camera = database.ReadCamera(id);
+    copy_intrinsics(database_camera);
+    database.UpdateCamera(database_camera);
+    if (reconstruction != nullptr) {
+      copy_intrinsics(reconstruction->Camera(id));
+    }
+  }
+  return id;
+}
+
 camera_t RigFrameLenses::MoveToOwnCamera(const size_t lens_idx,
                                          const camera_t shared_camera_id,
                                          Database& database,

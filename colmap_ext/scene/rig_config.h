@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,18 @@ class RigFrameLenses {
   // name. Throws std::invalid_argument when the frame has an image of that
   // lens already.
   std::optional<std::string> Add(size_t lens_idx, const Image& image);
+
+  // The camera of lens `lens_idx` in the rig, from `camera_id`, the camera
+  // of its images (none: throws std::invalid_argument naming the lens's
+  // prefix and suffix). A camera that another lens of the rig has already
+  // (`rig_camera_ids`, to which the result is added) is split off
+  // (MoveToOwnCamera); the config's intrinsics, if it has any, are written
+  // to the database and the reconstruction.
+  camera_t ConfigureCamera(size_t lens_idx,
+                           const std::optional<camera_t>& camera_id,
+                           std::set<camera_t>* rig_camera_ids,
+                           Database& database,
+                           Reconstruction* reconstruction);
 
   // Gives lens `lens_idx`, whose images have the camera `shared_camera_id`
   // of another lens of the rig (all lenses extracted as one camera, e.g.
