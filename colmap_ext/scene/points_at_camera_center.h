@@ -22,7 +22,9 @@ namespace colmap {
 double MinDistanceFromSphericalCenter(const Reconstruction& reconstruction);
 
 // The observations of `image` whose 3D point is nearer than `min_distance`
-// to the image's projection centre.
+// to the image's projection centre, one per 3D point (a track may hold two
+// observations of one image; deleting both of a two-element track would
+// delete a point twice).
 std::vector<point2D_t> ObservationsAtCenter(const Reconstruction& reconstruction,
                                             const Image& image,
                                             double min_distance);

@@ -40,6 +40,27 @@ TEST(PointsAtCameraCenter, APointAtACentreIsFound) {
             std::vector<point2D_t>{observed});
 }
 
+TEST(PointsAtCameraCenter, APointSeenTwiceByAnImageIsListedOnce) {
+  Reconstruction reconstruction = Panoramas();
+  const double min_distance = MinDistanceFromSphericalCenter(reconstruction);
+  const image_t image_id = *reconstruction.RegImageIds().begin();
+  const Image& image = reconstruction.Image(image_id);
+  point2D_t observed = 0;
+  while (!image.Point2D(observed).HasPoint3D()) {
+    ++observed;
+  }
+  point2D_t free = 0;
+  while (image.Point2D(free).HasPoint3D()) {
+    ++free;
+  }
+  ASSERT_LT(free, image.NumPoints2D());
+  const point3D_t point3D_id = image.Point2D(observed).point3D_id;
+  reconstruction.AddObservation(point3D_id, TrackElement(image_id, free));
+  reconstruction.Point3D(point3D_id).xyz = image.ProjectionCenter();
+  EXPECT_EQ(ObservationsAtCenter(reconstruction, image, min_distance).size(),
+            1);
+}
+
 TEST(PointsAtCameraCenter, PerspectiveCamerasAreNotMeasured) {
   SyntheticDatasetOptions options;
   options.num_rigs = 1;

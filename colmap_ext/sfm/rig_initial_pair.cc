@@ -129,8 +129,15 @@ std::optional<IncrementalMapperImpl::InitInfo> EstimateInitialRigFramePair(
                                        &pano2_from_pano1,
                                        &num_inliers,
                                        &inlier_mask) ||
-      !rig2_from_rig1.has_value() ||
       static_cast<int>(num_inliers) < options.init_min_num_inliers) {
+    return std::nullopt;
+  }
+  // Lenses that share one centre (a rig config without offsets) form a
+  // panorama, whose motion comes up to scale.
+  if (!rig2_from_rig1.has_value()) {
+    rig2_from_rig1 = pano2_from_pano1;
+  }
+  if (!rig2_from_rig1.has_value()) {
     return std::nullopt;
   }
 

@@ -40,7 +40,7 @@ void MarkFramePairTried(const DatabaseCache& database_cache,
 // sees far directions, whose rays barely converge, so upstream's median
 // angle of a single camera's pair would refuse a well-determined pair.
 // Returned as the pose between the two images. std::nullopt for images of
-// one frame, a rotation only, or too few inliers at a wide angle.
+// one frame, or too few inliers at a wide angle.
 std::optional<IncrementalMapperImpl::InitInfo> EstimateInitialRigFramePair(
     const IncrementalMapper::Options& options,
     const DatabaseCache& database_cache,

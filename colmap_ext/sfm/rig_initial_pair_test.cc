@@ -16,13 +16,13 @@ struct SyntheticScene {
 
 // Frames of rigs of `num_cameras` perspective cameras, each lens a few
 // centimetres from the rig's origin, all points seen by every image.
-SyntheticScene MakeScene(int num_cameras) {
+SyntheticScene MakeScene(int num_cameras, double offset_stddev = 0.05) {
   SyntheticDatasetOptions options;
   options.num_rigs = 1;
   options.num_cameras_per_rig = num_cameras;
   options.num_frames_per_rig = 4;
   options.num_points3D = 200;
-  options.sensor_from_rig_translation_stddev = 0.05;
+  options.sensor_from_rig_translation_stddev = offset_stddev;
   SyntheticScene scene;
   std::shared_ptr<Database> database =
       Database::Open(kInMemorySqliteDatabasePath);
@@ -92,6 +92,23 @@ TEST(RigInitialPair, RecoversTheRelativePoseOfTwoImagesFromAllLenses) {
                        .has_value());
     }
   }
+}
+
+TEST(RigInitialPair, LensesSharingOneCentreInitializeUpToScale) {
+  // A rig config without offsets: the frames are panoramas.
+  const SyntheticScene scene = MakeScene(/*num_cameras=*/2, 0.0);
+  const auto [image_id1, image_id2] = ImagesOfTwoFrames(scene.truth);
+  const std::optional<IncrementalMapperImpl::InitInfo> info =
+      EstimateInitialRigFramePair(
+          MapperOptions(), *scene.cache, image_id1, image_id2);
+  ASSERT_TRUE(info.has_value());
+  const Rigid3d truth = scene.truth.Image(image_id2).CamFromWorld() *
+                        Inverse(scene.truth.Image(image_id1).CamFromWorld());
+  EXPECT_LT(truth.rotation().angularDistance(info->cam2_from_cam1.rotation()),
+            1e-6);
+  EXPECT_GT(truth.translation().normalized().dot(
+                info->cam2_from_cam1.translation().normalized()),
+            1 - 1e-9);
 }
 
 TEST(RigInitialPair, AFramePairIsTriedOnceForAllItsLenses) {
