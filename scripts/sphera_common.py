@@ -4,11 +4,14 @@ renderer sphera_render, and the camera rigs of the rendered sets.
 
 Standard library only; the functions that need numpy import it themselves,
 so that a script that does not use them starts without it."""
+import hashlib
 import math
 import os
 import re
+import shutil
 import struct
 import subprocess
+import tempfile
 import time
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -483,12 +486,89 @@ def run_logged(command, log_path, timeout, **options):
     return process.returncode, time.monotonic() - start
 
 
+# Rendered scenes are kept between runs, as ccache keeps objects: in
+# SPHERA_SCENE_CACHE (default ~/.cache/sphera/scenes; empty: no cache), at
+# most SPHERA_SCENE_CACHE_MB megabytes (default 3000; the least recently
+# used go first). A scene's key is the renderer's executable (its bytes:
+# our libraries are linked into it statically) and its arguments, with the
+# contents of every argument that names a file, so that a changed renderer
+# or rig file renders afresh. The renderer is deterministic for given
+# arguments (its seed is one of them) and writes no path into its output.
+SCENE_CACHE = os.environ.get(
+    "SPHERA_SCENE_CACHE",
+    os.path.join(os.path.expanduser("~"), ".cache", "sphera", "scenes"))
+SCENE_CACHE_MB = int(os.environ.get("SPHERA_SCENE_CACHE_MB", "3000"))
+
+
+def _render_key(program, args):
+    """The cache key of `PROGRAM --output ... ARGS`, or None when an
+    argument names a folder (its contents are not hashed)."""
+    digest = hashlib.sha256()
+    with open(program, "rb") as f:
+        digest.update(f.read())
+    for arg in args:
+        if os.path.isdir(arg):
+            return None
+        digest.update(b"\0")
+        if os.path.isfile(arg):
+            with open(arg, "rb") as f:
+                digest.update(b"file\0" + f.read())
+        else:
+            digest.update(arg.encode())
+    return digest.hexdigest()[:32]
+
+
+def _prune_scene_cache():
+    """Removes the least recently used scenes beyond SCENE_CACHE_MB."""
+    entries = []
+    for name in os.listdir(SCENE_CACHE):
+        path = os.path.join(SCENE_CACHE, name)
+        if name.startswith("tmp"):  # a render that was stopped
+            if os.path.getmtime(path) < time.time() - 86400:
+                shutil.rmtree(path, ignore_errors=True)
+            continue
+        if not os.path.isdir(path):
+            continue
+        size = sum(os.path.getsize(os.path.join(folder, file))
+                   for folder, _, files in os.walk(path) for file in files)
+        entries.append((os.path.getmtime(path), size, path))
+    total = sum(size for _, size, _ in entries)
+    for _, size, path in sorted(entries):
+        if total <= SCENE_CACHE_MB * 1e6:
+            break
+        shutil.rmtree(path, ignore_errors=True)
+        total -= size
+
+
 def run_render(output, *args, program=None):
     """Runs `sphera_render --output OUTPUT ARGS` (PROGRAM, default
-    SPHERA_RENDER) without its output; a failure raises
-    subprocess.CalledProcessError."""
-    subprocess.run([program or RENDER, "--output", output, *map(str, args)],
-                   check=True, stdout=subprocess.DEVNULL)
+    SPHERA_RENDER) without its output, or copies the same scene from the
+    scene cache; a failure raises subprocess.CalledProcessError."""
+    program = shutil.which(program or RENDER) or program or RENDER
+    args = [str(arg) for arg in args]
+    key = _render_key(program, args) if SCENE_CACHE else None
+    cached = os.path.join(SCENE_CACHE, key) if key else None
+    if cached and os.path.isdir(cached):
+        os.utime(cached)
+        shutil.copytree(cached, output, dirs_exist_ok=True)
+        return
+    if not cached:
+        subprocess.run([program, "--output", output, *args], check=True,
+                       stdout=subprocess.DEVNULL)
+        return
+    os.makedirs(SCENE_CACHE, exist_ok=True)
+    staging = tempfile.mkdtemp(prefix="tmp", dir=SCENE_CACHE)
+    try:
+        subprocess.run([program, "--output", staging, *args], check=True,
+                       stdout=subprocess.DEVNULL)
+        shutil.copytree(staging, output, dirs_exist_ok=True)
+        try:
+            os.rename(staging, cached)  # another run may have stored it
+        except OSError:
+            pass
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    _prune_scene_cache()
 
 
 # ---------------------------------------------------------------------------
