@@ -30,21 +30,29 @@ uint64_t Hash(uint64_t a, uint64_t b, uint64_t c = 0, uint64_t d = 0,
   return SplitMix64(h ^ e);
 }
 
+// The last three rounds of Hash(a, b, c), whose d and e are zero:
+// Hash(a, b, c) = HashRest3(SplitMix64(SplitMix64(a) ^ b) ^ c), so that
+// hashes sharing a or (a, b) share their first rounds.
+uint64_t HashRest3(uint64_t x) { return SplitMix64(SplitMix64(SplitMix64(x))); }
+
 // Uniform in [0, 1) from the top 53 bits.
 double UnitFromHash(uint64_t h) { return (h >> 11) * (1.0 / 9007199254740992.0); }
 
 double Quintic(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 
-// Value noise in [0, 1] on the unit integer lattice.
-double ValueNoise(uint64_t key, double x, double y) {
+// Value noise in [0, 1] on the unit integer lattice, the lattice's values
+// Hash(key, i, j) (key_round = SplitMix64(key)).
+double ValueNoise(uint64_t key_round, double x, double y) {
   const double fx = std::floor(x), fy = std::floor(y);
   const int64_t ix = static_cast<int64_t>(fx), iy = static_cast<int64_t>(fy);
   const double tx = Quintic(x - fx), ty = Quintic(y - fy);
-  auto lattice = [&](int64_t i, int64_t j) {
-    return UnitFromHash(Hash(key, static_cast<uint64_t>(i), static_cast<uint64_t>(j)));
+  const uint64_t column0 = SplitMix64(key_round ^ static_cast<uint64_t>(ix));
+  const uint64_t column1 = SplitMix64(key_round ^ static_cast<uint64_t>(ix + 1));
+  auto lattice = [](uint64_t column, int64_t j) {
+    return UnitFromHash(HashRest3(column ^ static_cast<uint64_t>(j)));
   };
-  const double v00 = lattice(ix, iy), v10 = lattice(ix + 1, iy);
-  const double v01 = lattice(ix, iy + 1), v11 = lattice(ix + 1, iy + 1);
+  const double v00 = lattice(column0, iy), v10 = lattice(column1, iy);
+  const double v01 = lattice(column0, iy + 1), v11 = lattice(column1, iy + 1);
   const double a = v00 + (v10 - v00) * tx;
   const double b = v01 + (v11 - v01) * tx;
   return a + (b - a) * ty;
@@ -52,21 +60,38 @@ double ValueNoise(uint64_t key, double x, double y) {
 
 // Fractal sum of value noise, normalised to [0, 1]. Each octave is rotated
 // and shifted by a key-dependent amount so that lattices never line up.
-double Fbm(uint64_t key, const Eigen::Vector2d& uv, double base_frequency,
-           int octaves, double gain) {
-  double sum = 0, norm = 0, amplitude = 1, frequency = base_frequency;
+template <typename Noise, typename Octave>
+Noise MakeNoise(uint64_t key, double base_frequency, int octaves, double gain) {
+  Noise noise;
+  double amplitude = 1, frequency = base_frequency;
   for (int o = 0; o < octaves; ++o) {
     const uint64_t okey = Hash(key, 0x6f637476ULL, static_cast<uint64_t>(o));
     const double angle = 2 * M_PI * UnitFromHash(okey);
-    const double c = std::cos(angle), s = std::sin(angle);
-    const double x = frequency * (c * uv.x() - s * uv.y()) + 100 * UnitFromHash(okey >> 7);
-    const double y = frequency * (s * uv.x() + c * uv.y()) + 100 * UnitFromHash(okey >> 13);
-    sum += amplitude * ValueNoise(okey, x, y);
-    norm += amplitude;
+    Octave octave;
+    octave.key_round = SplitMix64(okey);
+    octave.cos = std::cos(angle);
+    octave.sin = std::sin(angle);
+    octave.shift_x = 100 * UnitFromHash(okey >> 7);
+    octave.shift_y = 100 * UnitFromHash(okey >> 13);
+    octave.frequency = frequency;
+    octave.amplitude = amplitude;
+    noise.octaves.push_back(octave);
+    noise.norm += amplitude;
     amplitude *= gain;
     frequency *= 2.07;
   }
-  return sum / norm;
+  return noise;
+}
+
+template <typename Noise>
+double Fbm(const Noise& noise, const Eigen::Vector2d& uv) {
+  double sum = 0;
+  for (const auto& o : noise.octaves) {
+    const double x = o.frequency * (o.cos * uv.x() - o.sin * uv.y()) + o.shift_x;
+    const double y = o.frequency * (o.sin * uv.x() + o.cos * uv.y()) + o.shift_y;
+    sum += o.amplitude * ValueNoise(o.key_round, x, y);
+  }
+  return sum / noise.norm;
 }
 
 Eigen::Vector3f HsvToRgb(double h, double s, double v) {
@@ -87,27 +112,34 @@ Eigen::Vector3f HsvToRgb(double h, double s, double v) {
 // Random flat shapes (disk, ring, rotated square, ellipse, stripe bar) in a
 // jittered grid of cells of side `cell`; at most one shape per cell, reaching
 // at most one cell beyond its own, so a 3x3 neighbourhood holds every shape
-// that can cover a point. Returns the topmost shape's colour.
-bool ShapeColour(uint64_t key, const Eigen::Vector2d& uv, double cell, double occupancy,
-                 Eigen::Vector3f* colour) {
+// that can cover a point. Returns the topmost shape's colour. The cells'
+// hashes are Hash(key, i, j) (key_round = SplitMix64(key)), their values
+// Hash(h, n).
+bool ShapeColour(uint64_t key_round, const Eigen::Vector2d& uv, double cell,
+                 double occupancy, Eigen::Vector3f* colour) {
   const int64_t ci = static_cast<int64_t>(std::floor(uv.x() / cell));
   const int64_t cj = static_cast<int64_t>(std::floor(uv.y() / cell));
   double best_priority = -1;
   for (int64_t dj = -1; dj <= 1; ++dj) {
     for (int64_t di = -1; di <= 1; ++di) {
       const int64_t i = ci + di, j = cj + dj;
-      const uint64_t h = Hash(key, static_cast<uint64_t>(i), static_cast<uint64_t>(j));
-      if (UnitFromHash(Hash(h, 1)) >= occupancy) continue;  // empty cell
-      const double priority = UnitFromHash(Hash(h, 2));
+      const uint64_t h = HashRest3(
+          SplitMix64(key_round ^ static_cast<uint64_t>(i)) ^ static_cast<uint64_t>(j));
+      const uint64_t h_round = SplitMix64(h);
+      // Hash(h, n): its rounds of c, d and e are plain rounds.
+      auto value = [h_round](uint64_t n) {
+        return UnitFromHash(SplitMix64(HashRest3(h_round ^ n)));
+      };
+      if (value(1) >= occupancy) continue;  // empty cell
+      const double priority = value(2);
       if (priority <= best_priority) continue;
-      const Eigen::Vector2d centre((i + UnitFromHash(Hash(h, 3))) * cell,
-                                   (j + UnitFromHash(Hash(h, 4))) * cell);
-      const double radius = cell * (0.25 + 0.75 * UnitFromHash(Hash(h, 5)));
-      const double angle = M_PI * UnitFromHash(Hash(h, 6));
+      const Eigen::Vector2d centre((i + value(3)) * cell, (j + value(4)) * cell);
+      const double radius = cell * (0.25 + 0.75 * value(5));
+      const double angle = M_PI * value(6);
       const Eigen::Vector2d p = uv - centre;
       const double c = std::cos(angle), s = std::sin(angle);
       const double x = c * p.x() + s * p.y(), y = -s * p.x() + c * p.y();
-      const int type = static_cast<int>(Hash(h, 7) % 5);
+      const int type = static_cast<int>(SplitMix64(HashRest3(h_round ^ 7)) % 5);
       bool inside = false;
       switch (type) {
         case 0: inside = x * x + y * y < radius * radius; break;
@@ -122,12 +154,12 @@ bool ShapeColour(uint64_t key, const Eigen::Vector2d& uv, double cell, double oc
       }
       if (!inside) continue;
       best_priority = priority;
-      const double hue = UnitFromHash(Hash(h, 8));
-      const double saturation = 0.5 + 0.5 * UnitFromHash(Hash(h, 9));
+      const double hue = value(8);
+      const double saturation = 0.5 + 0.5 * value(9);
       // Dark or bright, rarely in between: strong edges against the noise.
-      const double value = UnitFromHash(Hash(h, 10)) < 0.45 ? 0.08 + 0.15 * UnitFromHash(Hash(h, 11))
-                                                             : 0.8 + 0.2 * UnitFromHash(Hash(h, 11));
-      *colour = HsvToRgb(hue, saturation, value);
+      const double brightness = value(10) < 0.45 ? 0.08 + 0.15 * value(11)
+                                                 : 0.8 + 0.2 * value(11);
+      *colour = HsvToRgb(hue, saturation, brightness);
     }
   }
   return best_priority >= 0;
@@ -178,6 +210,7 @@ Scene::Scene(const SceneOptions& options) : options_(options) {
     };
     for (const AlignedBox& box : boxes) AddBox(box);
   }
+  PrepareTextures();
   double total = 0;
   for (const Face& face : faces_) {
     total += face.Area();
@@ -248,25 +281,46 @@ Eigen::Vector3f Scene::Colour(int face_id, const Eigen::Vector3d& point) const {
   return ProceduralColour(face_id, uv);
 }
 
+namespace {
+// Shapes on three scales, the smallest drawn on top: (cell side in metres,
+// probability that a cell holds a shape).
+constexpr std::pair<double, double> kShapeLayers[] = {{0.06, 0.2}, {0.16, 0.35}, {0.45, 0.6}};
+}  // namespace
+
+void Scene::PrepareTextures() {
+  textures_.clear();
+  for (size_t face_id = 0; face_id < faces_.size(); ++face_id) {
+    const uint64_t key = Hash(options_.seed, 0x726f6f6dULL, static_cast<uint64_t>(face_id));
+    FaceTexture texture;
+    // Luminance detail from 0.5 m down to ~8 mm.
+    texture.detail = MakeNoise<Noise, NoiseOctave>(Hash(key, 1), 2.0, 7, 0.6);
+    for (int k = 0; k < 3; ++k) {
+      texture.shape_keys[k] = SplitMix64(
+          Hash(key, 2, static_cast<uint64_t>(kShapeLayers[k].first * 1000)));
+    }
+    // Slowly varying tint per channel.
+    for (int c = 0; c < 3; ++c) {
+      texture.tint[c] =
+          MakeNoise<Noise, NoiseOctave>(Hash(key, 3, static_cast<uint64_t>(c)), 0.8, 2, 0.5);
+    }
+    textures_.push_back(texture);
+  }
+}
+
 Eigen::Vector3f Scene::ProceduralColour(int face_id, const Eigen::Vector2d& uv) const {
-  const uint64_t key = Hash(options_.seed, 0x726f6f6dULL, static_cast<uint64_t>(face_id));
-  // Luminance detail from 0.5 m down to ~8 mm, contrast-stretched.
-  const double detail = Fbm(Hash(key, 1), uv, 2.0, 7, 0.6);
-  const double luminance = std::clamp(0.5 + 2.2 * (detail - 0.5), 0.0, 1.0);
-  // Shapes on three scales; the smallest are drawn on top.
+  const FaceTexture& texture = textures_[face_id];
+  // Contrast-stretched detail.
+  const double luminance = std::clamp(0.5 + 2.2 * (Fbm(texture.detail, uv) - 0.5), 0.0, 1.0);
   Eigen::Vector3f shape;
-  // (cell side in metres, probability that a cell holds a shape)
-  const std::pair<double, double> layers[] = {{0.06, 0.2}, {0.16, 0.35}, {0.45, 0.6}};
-  for (const auto& [cell, occupancy] : layers) {
-    if (ShapeColour(Hash(key, 2, static_cast<uint64_t>(cell * 1000)), uv, cell, occupancy,
+  for (int k = 0; k < 3; ++k) {
+    if (ShapeColour(texture.shape_keys[k], uv, kShapeLayers[k].first, kShapeLayers[k].second,
                     &shape)) {
       return (shape * static_cast<float>(0.75 + 0.5 * luminance)).cwiseMin(1.0f);
     }
   }
-  // Slowly varying tint per channel.
   Eigen::Vector3f colour;
   for (int c = 0; c < 3; ++c) {
-    const double tint = Fbm(Hash(key, 3, static_cast<uint64_t>(c)), uv, 0.8, 2, 0.5);
+    const double tint = Fbm(texture.tint[c], uv);
     colour[c] = static_cast<float>(luminance * (0.35 + 1.3 * tint));
   }
   return colour.cwiseMax(0.0f).cwiseMin(1.0f);

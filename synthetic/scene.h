@@ -16,6 +16,7 @@
 #ifndef SPHERA_SYNTHETIC_SCENE_H_
 #define SPHERA_SYNTHETIC_SCENE_H_
 
+#include <array>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -107,8 +108,29 @@ class Scene {
   void AddBox(const AlignedBox& box);
   Eigen::Vector3f ProceduralColour(int face_id, const Eigen::Vector2d& uv) const;
 
+  // One octave of a face's fractal noise: its hash key (after the hash's
+  // first round), rotation, shift, frequency and amplitude.
+  struct NoiseOctave {
+    uint64_t key_round = 0;
+    double cos = 1, sin = 0, shift_x = 0, shift_y = 0;
+    double frequency = 0, amplitude = 0;
+  };
+  struct Noise {
+    std::vector<NoiseOctave> octaves;
+    double norm = 0;  // the sum of the amplitudes
+  };
+  // What the procedural texture of a face draws from the seed and the face
+  // alone, computed once per face: the texture is most of a render's time.
+  struct FaceTexture {
+    Noise detail;
+    std::array<uint64_t, 3> shape_keys{};
+    std::array<Noise, 3> tint;
+  };
+  void PrepareTextures();
+
   SceneOptions options_;
   std::vector<Face> faces_;
+  std::vector<FaceTexture> textures_;
   std::vector<AlignedBox> boxes_;
   std::vector<double> cumulative_area_;
 };
