@@ -27,7 +27,8 @@
 // its image. THIN_PRISM_FISHEYE takes theta_max from its radial terms (k1, k2,
 // k3, k4) and in addition needs a positive Jacobian determinant of
 // (a, b) -> (ad, bd) at the ray: its tangential and prism terms shift the fold
-// locally. CheckParams refuses parameters whose fold lies inside the image.
+// locally. CheckParams refuses parameters whose fold lies inside the image
+// circle (fold.h).
 //
 // Unprojection, m = ((px - cx) / fx, (py - cy) / fy): OPENCV_FISHEYE solves
 // r(theta) = |m| on [0, theta_max) by safeguarded Newton; THIN_PRISM_FISHEYE
@@ -459,11 +460,11 @@ struct ThinPrismFisheyeModel {
     return true;
   }
 
-  // Refuses a fold inside the image. The visible region ends, along each of
-  // 360 meridians of the theta plane, at the first theta where the Jacobian
-  // determinant of the distortion reaches 0 (located on 512 steps, then
-  // bisected) or at the radial fold theta_max; a fold is inside the image
-  // when that boundary point's pixel is.
+  // Refuses a fold inside the image circle (ImageCircleRadius). The visible
+  // region ends, along each of 360 meridians of the theta plane, at the
+  // first theta where the Jacobian determinant of the distortion reaches 0
+  // (located on 512 steps, then bisected) or at the radial fold theta_max; a
+  // fold is inside the image circle when that boundary point's pixel is.
   static std::string CheckParams(const std::vector<double>& params, int width,
                                  int height) {
     using namespace internal;
@@ -474,6 +475,8 @@ struct ThinPrismFisheyeModel {
     if (width <= 0 || height <= 0) return "";
     const KannalaBrandtField field = FieldOfView(params.data());
     const double* extra = params.data() + 4;
+    const double circle_px =
+        ImageCircleRadius(params[2], params[3], width, height);
     constexpr int kMeridians = 360;
     constexpr int kSteps = 512;
     double best_theta = std::numeric_limits<double>::infinity();
@@ -502,7 +505,7 @@ struct ThinPrismFisheyeModel {
       ThinPrismDistortion(extra, boundary * dir_a, boundary * dir_b, &ad, &bd);
       const double x = params[0] * ad + params[2];
       const double y = params[1] * bd + params[3];
-      if (x >= 0 && x <= width && y >= 0 && y <= height) {
+      if (std::hypot(x - params[2], y - params[3]) <= circle_px) {
         best_theta = boundary;
         best_x = x;
         best_y = y;
@@ -511,8 +514,8 @@ struct ThinPrismFisheyeModel {
     if (!std::isfinite(best_theta)) return "";
     return FoldMessage(kModelName, best_theta,
                        std::hypot(best_x - params[2], best_y - params[3]),
-                       width, height,
-                       "at pixel (" + FormatFixed(best_x, 1) + ", " +
+                       params[2], params[3], width, height,
+                       ": at pixel (" + FormatFixed(best_x, 1) + ", " +
                            FormatFixed(best_y, 1) + ")");
   }
 };

@@ -27,8 +27,8 @@ constexpr double kPi = internal::kPi;
 constexpr double kDeg = kPi / 180;
 
 // A 210° lens: the fitted polynomial turns over at 105.44° (r = 1.5567 f),
-// so a 640 x 640 image (corner 452.5 px from the centre, fold at 467.5 px)
-// holds no fold and a 1600 x 1088 one does.
+// so the image circle of a 640 x 640 image (320 px about the centre, fold
+// at 467 px) holds no fold and that of a 1600 x 1088 one does.
 const std::vector<double> kFisheye = {300.5, 300.1, 320.3,  320.2,
                                       0.015, -0.01, -0.003, 0.0002};
 // The same radial terms with tangential and thin-prism terms.
@@ -380,24 +380,37 @@ TEST(OpenCVFisheye, FoldFreeLensSeesAlmostEverything) {
                                                 ray.data()));
 }
 
-TEST(OpenCVFisheye, CheckParamsReportsFoldInsideImage) {
+TEST(OpenCVFisheye, CheckParamsReportsFoldInsideImageCircle) {
   EXPECT_EQ(OpenCVFisheyeModel::CheckParams(kFisheye, 640, 640), "");
   EXPECT_EQ(OpenCVFisheyeModel::CheckParams(kFisheye, 0, 0), "");
   EXPECT_EQ(OpenCVFisheyeModel::CheckParams(kEquidistant, 4000, 4000), "");
-  // The fold at 105.44° is r = 1.55667 f = 467.6 px along the corner (0, 0)'s
-  // direction; that corner is hypot(320.3, 320.2) = 452.9 px away in the
-  // 640 x 640 image and 967.8 px in a 1600 x 1088 one centred at (800, 544).
+  // The fold at 105.44° is r = 1.55667 f, 467.2 px along fy. A 1600 x 1088
+  // image about (800.3, 544.2) holds a circle of 800.3 px (to its left
+  // edge): the fold is inside it.
   std::vector<double> wide = kFisheye;
   wide[2] = 800.3;
   wide[3] = 544.2;
   const std::string message = OpenCVFisheyeModel::CheckParams(wide, 1600, 1088);
   EXPECT_THAT(message, HasSubstr("OPENCV_FISHEYE: projection folds at 105.4° "
-                                 "(r = 467."));
-  EXPECT_THAT(message, HasSubstr("inside the 1600x1088 image"));
-  EXPECT_THAT(message, HasSubstr("corner (0, 0) is 967.8 px"));
-  // 660 x 660 about (320, 320): corner 481 px, beyond the fold.
-  EXPECT_THAT(OpenCVFisheyeModel::CheckParams(kFisheye, 660, 660),
-              HasSubstr("projection folds"));
+                                 "(r = 467.2 px), inside the image circle of "
+                                 "the 1600x1088 image (radius 800.3 px about "
+                                 "the principal point (800.3, 544.2))"));
+  // A 660 x 660 image about (320.3, 320.2): its corners (481 px away) lie
+  // past the fold, its circle (339.8 px) does not. A fisheye's pixels end at
+  // its circle, so the fold leaves every one of them its ray.
+  EXPECT_EQ(OpenCVFisheyeModel::CheckParams(kFisheye, 660, 660), "");
+  // A circle cropped by the top and bottom edges, as on 8-lens cameras: the
+  // fold at 1.55667 * 450 = 700.5 px lies beyond the half height (544 px)
+  // but inside the circle that reaches the left and right edges (800 px).
+  std::vector<double> cropped = kFisheye;
+  cropped[0] = cropped[1] = 450;
+  cropped[2] = 800;
+  cropped[3] = 544;
+  EXPECT_THAT(OpenCVFisheyeModel::CheckParams(cropped, 1600, 1088),
+              HasSubstr("(r = 700.5 px), inside the image circle"));
+  // The same lens on a 1000 x 1000 image: circle 500 px, corners 707 px.
+  cropped[2] = cropped[3] = 500;
+  EXPECT_EQ(OpenCVFisheyeModel::CheckParams(cropped, 1000, 1000), "");
 
   EXPECT_THAT(OpenCVFisheyeModel::CheckParams({300, 300, 320, 320}, 0, 0),
               HasSubstr("expected 8 params"));
@@ -409,15 +422,19 @@ TEST(OpenCVFisheye, CheckParamsReportsFoldInsideImage) {
   EXPECT_THAT(OpenCVFisheyeModel::CheckParams(bad, 0, 0), HasSubstr("fy=-1"));
 }
 
-TEST(ThinPrismFisheye, CheckParamsReportsFoldInsideImage) {
+TEST(ThinPrismFisheye, CheckParamsReportsFoldInsideImageCircle) {
   EXPECT_EQ(ThinPrismFisheyeModel::CheckParams(kThinPrism, 640, 640), "");
+  // Corners past the fold, the circle (339.8 px) inside it.
+  EXPECT_EQ(ThinPrismFisheyeModel::CheckParams(kThinPrism, 660, 660), "");
   EXPECT_EQ(ThinPrismFisheyeModel::CheckParams(kThinPrism, 0, 0), "");
   const std::string message =
       ThinPrismFisheyeModel::CheckParams(kThinPrism, 1600, 1088);
   // The prism terms move the fold off 105.4° by less than a tenth of a degree.
   EXPECT_THAT(message,
               HasSubstr("THIN_PRISM_FISHEYE: projection folds at 105."));
-  EXPECT_THAT(message, HasSubstr("inside the 1600x1088 image: at pixel"));
+  EXPECT_THAT(message, HasSubstr("inside the image circle of the 1600x1088 "
+                                 "image (radius 1279.7 px about the "
+                                 "principal point (320.3, 320.2)): at pixel"));
   EXPECT_THAT(ThinPrismFisheyeModel::CheckParams(kFisheye, 0, 0),
               HasSubstr("expected 12 params"));
   std::vector<double> bad = kThinPrism;

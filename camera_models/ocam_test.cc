@@ -273,14 +273,14 @@ TEST(OCam, InitialParamsArePinhole) {
 TEST(OCam, CheckParams) {
   EXPECT_EQ(OCamModel::CheckParams(kOCam, 1624, 1203), "");
   EXPECT_EQ(OCamModel::CheckParams(kOCam, 0, 0), "");
-  // The fold at rho = 1211.9 lies beyond the corners of a 1624 x 1203 image
-  // (about 1011 px away) and inside a 2600 x 2000 one.
+  // The fold at rho = 1211.9 lies beyond the image circle of a 1624 x 1203
+  // image and inside that of a 2600 x 2000 one (1788 px to its right edge).
   EXPECT_EQ(OCamModel::CheckParams(kOCamFold, 1624, 1203), "");
   EXPECT_EQ(OCamModel::CheckParams(kOCamFold, 0, 0), "");
   const std::string message = OCamModel::CheckParams(kOCamFold, 2600, 2000);
   EXPECT_THAT(message, HasSubstr("OCAM: projection folds at 111.1° (r = 121"));
-  EXPECT_THAT(message, HasSubstr("inside the 2600x2000 image: its corner "
-                                 "(2600, 2000)"));
+  EXPECT_THAT(message, HasSubstr("inside the image circle of the 2600x2000 "
+                                 "image (radius 17"));
 
   std::vector<double> params = kOCam;
   params[5] = 300;
