@@ -815,8 +815,10 @@ double DarkRimFraction(const cv::Mat& lens_image,
       continue;
     }
     // The darkest of up to kNumOuterBands bands side by side outside the
-    // circle, the first of which must be in the image.
+    // circle, the first of which must be in the image; and that first band.
     bool outer_visible = false;
+    double first_mean = 0;
+    double last_mean = 0;
     for (int band = 0; band < kNumOuterBands; ++band) {
       const double begin = circle.r + gap + band * width;
       double mean = 0;
@@ -825,6 +827,10 @@ double DarkRimFraction(const cv::Mat& lens_image,
                      &mean)) {
         break;
       }
+      if (!outer_visible) {
+        first_mean = mean;
+      }
+      last_mean = mean;
       outer_mean = outer_visible ? std::min(outer_mean, mean) : mean;
       outer_visible = true;
     }
@@ -832,7 +838,11 @@ double DarkRimFraction(const cv::Mat& lens_image,
       continue;
     }
     ++num_counted;
-    if (outer_mean <= kMaxDarkRatio * inner_mean) {
+    // Dark outside, or the bright inner edge of a lens housing right at the
+    // circle (its rim catching light beside a darker picture), fading
+    // outwards.
+    if (outer_mean <= kMaxDarkRatio * inner_mean ||
+        (kMaxDarkRatio * first_mean >= inner_mean && first_mean > last_mean)) {
       ++num_dark;
     }
   }
@@ -859,9 +869,10 @@ std::string LensImageCircleError(const cv::Mat& lens_image,
     char text[320];
     std::snprintf(text,
                   sizeof(text),
-                  "only %.0f%% of the rim of its image circle is dark "
-                  "outside (at least %.0f%% must be): not a dual-fisheye "
-                  "frame (a normal photo or an equirectangular panorama?)",
+                  "only %.0f%% of the rim of its image circle ends the "
+                  "picture (dark outside, or a housing's bright rim; at "
+                  "least %.0f%% must): not a dual-fisheye frame (a normal "
+                  "photo or an equirectangular panorama?)",
                   100 * fraction,
                   100 * kMinDarkRimFraction);
     return text;

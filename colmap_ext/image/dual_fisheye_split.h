@@ -45,11 +45,14 @@ struct LensImage {
 inline constexpr double kMinImageCircleCoverage = 0.2;
 
 // A frame is dual-fisheye when, in each lens, at least this fraction of the
-// visible rim of its image circle is dark on the outside: the lens's edge,
-// then its housing or black, next to the picture inside. Flare and bright
-// housing parts leave some of the rim bright; a normal photo or a stitched
-// panorama, whose pictures go on across any circle, leave most of it.
-inline constexpr double kMinDarkRimFraction = 0.5;
+// visible rim of its image circle ends the picture: dark on the outside
+// (the lens's edge, then its housing or black), or the bright inner edge of
+// a housing beside a darker picture. Flare, housing parts as bright as the
+// picture and vignetting leave some of the rim unchanged (a rendered
+// consumer camera with a bright housing: 31-45% of the rim dark outside);
+// a normal photo or a stitched panorama, whose pictures go on across any
+// circle, leave most of it (the real panoramas of the shared data: 4-17%).
+inline constexpr double kMinDarkRimFraction = 0.35;
 
 // Why RAW cannot be a side-by-side dual-fisheye frame by its size and type
 // (LensImageError, or an odd width), or "".
@@ -87,7 +90,9 @@ cv::Mat BrightPixelMask(const cv::Mat& image, int black_level);
 // bands just outside it (each max(2 px, 2% of r) wide, max(1 px, 0.5% of r)
 // away from the circle, so that the lens's blurred edge counts for
 // neither): the rim is dark there when the darkest of three outside bands
-// side by side is at most 60% of the inside. Three, so that a circle given a
+// side by side is at most 60% of the inside, or when the first of them is
+// at least the inside over 60% (a housing's bright rim). Three, so that a
+// circle given a
 // little inside the picture's edge (a conservative circle from a maker's
 // file, 1-3% of r) still finds the dark beyond it. Only directions whose
 // first outside band is in the image and whose inside band is brighter than

@@ -459,6 +459,62 @@ TEST(DualFisheyeSplit, TellsAHousedFrameFromAPhotoAndAPanorama) {
       "not a dual-fisheye frame"));
 }
 
+// A picture of flat patches (cells of 12 px, intensities 20 to 230).
+cv::Mat MakePatchPicture(int size, unsigned seed) {
+  cv::theRNG().state = seed;
+  cv::Mat coarse(size / 12 + 2, size / 12 + 2, CV_32FC1);
+  cv::randu(coarse, cv::Scalar::all(20), cv::Scalar::all(230));
+  cv::Mat picture;
+  cv::resize(coarse, picture, cv::Size(size, size), 0, 0, cv::INTER_NEAREST);
+  return picture(cv::Rect(0, 0, size, size)).clone();
+}
+
+// A lens image as sphera_render --realistic draws it: the picture darkened
+// towards the circle by vignetting (35% at the rim), then a housing ring
+// brightest at its inner edge (82 DN, where the front element's rim catches
+// light, fading to 27 DN at 1.15 r), noise, and a dark surround. Beside a
+// dark patch the housing is brighter than the picture, beside a bright one
+// darker, and beside a middle one about as bright.
+cv::Mat MakeBrightHousingLensImage(int size, const ImageCircle& circle,
+                                   unsigned seed) {
+  const cv::Mat picture = MakePatchPicture(size, seed);
+  cv::Mat noise(size, size, CV_32FC1);
+  cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(2));
+  cv::Mat image(size, size, CV_8UC1);
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      const double d =
+          std::hypot(x + 0.5 - circle.cx, y + 0.5 - circle.cy) / circle.r;
+      double value;
+      if (d <= 1.0) {
+        value = picture.at<float>(y, x) * (1.0 - 0.35 * d * d);
+      } else if (d <= 1.15) {
+        value = 55 * (1.5 - (d - 1) / 0.15);
+      } else {
+        value = 14;
+      }
+      image.at<uchar>(y, x) =
+          cv::saturate_cast<uchar>(value + noise.at<float>(y, x));
+    }
+  }
+  return image;
+}
+
+TEST(DualFisheyeSplit, TellsABrightHousingFromAPhoto) {
+  const int size = 480;
+  const ImageCircle circle{240, 240, 208};
+  const cv::Mat housed = MakeBrightHousingLensImage(size, circle, 7);
+  EXPECT_GT(DarkRimFraction(housed, circle, 10), kMinDarkRimFraction);
+  EXPECT_EQ(LensImageCircleError(housed, circle, 10), "");
+
+  // The same picture going on across the circle (a normal photo): refused.
+  cv::Mat photo;
+  MakePatchPicture(size, 7).convertTo(photo, CV_8UC1);
+  EXPECT_LT(DarkRimFraction(photo, circle, 10), kMinDarkRimFraction);
+  EXPECT_TRUE(Contains(LensImageCircleError(photo, circle, 10),
+                       "not a dual-fisheye frame"));
+}
+
 TEST(DualFisheyeSplit, TakesTheMedianOfDetectedCircles) {
   const ImageCircle median = MedianImageCircle({ImageCircle{10, 20, 30},
                                                 ImageCircle{11, 25, 29},
