@@ -326,14 +326,7 @@ def summarize(runs):
     for (preset, system), rows in groups.items():
         out = {"preset": preset, "system": system, "runs": len(rows),
                "failed": sum(1 for r in rows if r.get("error"))}
-        for key in COLUMNS[3:-1]:
-            values = [float(r[key]) for r in rows
-                      if r.get(key) not in (None, "")]
-            if values:
-                out[key] = common.median(values)
-                if key in SPREAD:
-                    out[key + "_min"] = min(values)
-                    out[key + "_max"] = max(values)
+        out.update(common.medians_and_spreads(rows, COLUMNS[3:-1], SPREAD))
         summary.append(out)
     # Ratios of every system's median position and rotation error to the
     # rig's of the same preset.
@@ -354,6 +347,14 @@ def fmt(value, digits=3):
     return str(value)
 
 
+def spread_cell(row, key):
+    """'median [min..max]' of KEY in a summary ROW, or the value alone."""
+    if key + "_min" in row:
+        return (f"{fmt(row.get(key))} [{fmt(row[key + '_min'])}.."
+                f"{fmt(row[key + '_max'])}]")
+    return fmt(row.get(key))
+
+
 def print_table(summary):
     header = ["preset", "system", "reg/frames", "rot med deg", "pos med mm",
               "pos max mm", "rig rot deg", "rig pos mm", "time s",
@@ -361,10 +362,7 @@ def print_table(summary):
     lines = [header]
     for row in summary:
         def cell(key):
-            if key + "_min" in row:
-                return (f"{fmt(row.get(key))} [{fmt(row[key + '_min'])}.."
-                        f"{fmt(row[key + '_max'])}]")
-            return fmt(row.get(key))
+            return spread_cell(row, key)
         lines.append([row["preset"], row["system"],
                       f"{fmt(row.get('registered'))}/{fmt(row.get('frames'))}",
                       cell("rot_median_deg"), cell("pos_median_mm"),

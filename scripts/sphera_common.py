@@ -394,6 +394,21 @@ def rig_errors(gt_path, model_path):
     return errors
 
 
+def medians_and_spreads(rows, keys, spread_keys):
+    """{key: median} over ROWS (dicts) of every key of KEYS that some row
+    holds a value of, with key_min and key_max for the keys of
+    SPREAD_KEYS."""
+    out = {}
+    for key in keys:
+        values = [float(r[key]) for r in rows if r.get(key) not in (None, "")]
+        if values:
+            out[key] = median(values)
+            if key in spread_keys:
+                out[key + "_min"] = min(values)
+                out[key + "_max"] = max(values)
+    return out
+
+
 def median(values):
     """The median of a non-empty sequence of numbers."""
     values = sorted(values)
