@@ -403,14 +403,39 @@ PresetResolution FindPresetResolution(const CameraPreset& preset,
                               "\"; known: " + KnownResolutions(preset));
 }
 
+std::string PresetLensModelError(const CameraPreset& preset,
+                                 const std::string& model_name) {
+  if (model_name.empty() || model_name == preset.model_name) return "";
+  if (preset.storage == LensStorage::kEquirectangular) {
+    return "--camera_model " + model_name + ": " + preset.name +
+           " stores stitched panoramas, one " + preset.model_name +
+           " camera";
+  }
+  static const char* const kLensModels[] = {
+      "OPENCV_FISHEYE", "THIN_PRISM_FISHEYE", "EUCM",
+      "UNIFIED_OMNI",   "DOUBLE_SPHERE",      "OCAM"};
+  std::string known;
+  for (const char* name : kLensModels) {
+    if (model_name == name) return "";
+    known += std::string(known.empty() ? "" : ", ") + name;
+  }
+  return "--camera_model " + model_name +
+         ": not a model for the lenses of a 360° camera; one of " + known;
+}
+
 PresetCamera PresetLensCamera(const CameraPreset& preset,
-                              const PresetResolution& resolution, int lens) {
+                              const PresetResolution& resolution, int lens,
+                              const std::string& model_name) {
+  if (const std::string error = PresetLensModelError(preset, model_name);
+      !error.empty()) {
+    throw std::invalid_argument(error);
+  }
   PresetCamera camera;
   const Eigen::Vector2i size = LensImageSize(preset, resolution);
   camera.width = size.x();
   camera.height = size.y();
-  camera.model_name = preset.model_name;
-  camera.model_id = ModelIdFromName(preset.model_name);
+  camera.model_name = model_name.empty() ? preset.model_name : model_name;
+  camera.model_id = ModelIdFromName(camera.model_name);
   if (preset.storage == LensStorage::kEquirectangular) {
     camera.params = {static_cast<double>(size.x()),
                      static_cast<double>(size.y())};
@@ -471,7 +496,8 @@ Eigen::Vector3d PresetCamFromRigTranslation(const CameraPreset& preset,
 
 std::string PresetRigConfigJson(const CameraPreset& preset,
                                 const PresetResolution& resolution,
-                                const std::vector<std::string>& lens_folders) {
+                                const std::vector<std::string>& lens_folders,
+                                const std::string& model_name) {
   if (!lens_folders.empty() && lens_folders.size() != preset.lenses.size()) {
     throw std::invalid_argument(
         preset.name + " has " + std::to_string(preset.lenses.size()) +
@@ -503,7 +529,8 @@ std::string PresetRigConfigJson(const CameraPreset& preset,
                                             Clean(t.z())};
     }
     const PresetCamera lens_camera =
-        PresetLensCamera(preset, resolution, static_cast<int>(lens));
+        PresetLensCamera(preset, resolution, static_cast<int>(lens),
+                         model_name);
     camera["camera_model_name"] = lens_camera.model_name;
     camera["camera_params"] = lens_camera.params;
     cameras.push_back(camera);
@@ -531,6 +558,13 @@ ResolvedPreset ResolveRigPreset(const RigPresetRequest& request) {
     throw std::invalid_argument(
         "give --resolution or --image_width and --image_height, not both");
   }
+  if (const std::string error =
+          PresetLensModelError(preset, request.camera_model);
+      !error.empty()) {
+    throw std::invalid_argument(error);
+  }
+  resolved.model_name =
+      request.camera_model.empty() ? preset.model_name : request.camera_model;
   if (!request.resolution.empty()) {
     resolved.resolution = FindPresetResolution(preset, request.resolution);
   } else if (has_size) {

@@ -130,8 +130,18 @@ struct PresetCamera {
   int height = 0;
   double fit_max_error_px = 0;  // of the fit, over the circle
 };
+// MODEL_NAME (empty: the preset's model_name) must be a whole-field lens
+// model (PresetLensModelError).
 PresetCamera PresetLensCamera(const CameraPreset& preset,
-                              const PresetResolution& resolution, int lens);
+                              const PresetResolution& resolution, int lens,
+                              const std::string& model_name = "");
+
+// Why MODEL_NAME cannot start the lenses of PRESET (not a model of
+// registry.h, not one of the whole-field lens models OPENCV_FISHEYE,
+// THIN_PRISM_FISHEYE, EUCM, UNIFIED_OMNI, DOUBLE_SPHERE, OCAM, or a preset
+// of stitched panoramas), or "" (also for an empty name: the preset's).
+std::string PresetLensModelError(const CameraPreset& preset,
+                                 const std::string& model_name);
 
 // cam_from_rig of lens LENS (lens 0 is the rig frame).
 Eigen::Quaterniond PresetCamFromRigRotation(const CameraPreset& preset,
@@ -140,15 +150,16 @@ Eigen::Vector3d PresetCamFromRigTranslation(const CameraPreset& preset,
                                             int lens);
 
 // rig_configurator's rig_config.json for the preset at the resolution: one
-// rig, lens 0 the reference sensor, every lens with its camera model and
-// parameters and (except lens 0) its nominal cam_from_rig. Images are named
+// rig, lens 0 the reference sensor, every lens with its camera model
+// (MODEL_NAME, empty: the preset's) and parameters and (except lens 0) its nominal cam_from_rig. Images are named
 // as the preset stores them after splitting: "FOLDER/NAME" with the folders
 // LENS_FOLDERS (empty: the preset's own), or NAME<file_suffix> for files
 // per lens.
 std::string PresetRigConfigJson(const CameraPreset& preset,
                                 const PresetResolution& resolution,
                                 const std::vector<std::string>& lens_folders =
-                                    {});
+                                    {},
+                                const std::string& model_name = "");
 
 // What `colmap rig_preset` is asked: a camera and a resolution, as given on
 // the command line. RESOLUTION is a name of the preset or "WxH"; without it,
@@ -159,11 +170,14 @@ struct RigPresetRequest {
   std::string resolution;
   int image_width = 0;
   int image_height = 0;
+  // The lenses' starting model (empty: the preset's).
+  std::string camera_model;
 };
 
 struct ResolvedPreset {
   const CameraPreset* preset = nullptr;
   PresetResolution resolution;
+  std::string model_name;  // the lenses' starting model
 };
 
 // Checks the request once; throws std::invalid_argument naming the bad

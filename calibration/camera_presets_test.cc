@@ -108,6 +108,76 @@ TEST(CameraPresets, EveryLensModelPassesItsChecks) {
   }
 }
 
+TEST(CameraPresets, LensesStartFromAnyWholeFieldModel) {
+  // Every lens model a preset's lenses may start from, at one resolution
+  // of each camera: the same equidistant lens, so the circle's centre and
+  // its edge at half the field of view land where the preset's own model
+  // puts them.
+  for (const std::string model : {"OPENCV_FISHEYE", "THIN_PRISM_FISHEYE",
+                                  "EUCM", "UNIFIED_OMNI", "DOUBLE_SPHERE",
+                                  "OCAM"}) {
+    for (const CameraPreset& preset : CameraPresets()) {
+      if (preset.storage == LensStorage::kEquirectangular) continue;
+      const PresetResolution resolution = Resolutions(preset).front();
+      const PresetCamera camera = PresetLensCamera(preset, resolution, 0, model);
+      const std::string where = model + " " + preset.name;
+      EXPECT_EQ(camera.model_name, model) << where;
+      EXPECT_EQ(camera.model_id, ModelIdFromName(model)) << where;
+      EXPECT_EQ(CheckParams(camera.model_id, camera.params, camera.width,
+                            camera.height),
+                "")
+          << where;
+      const PresetCircle& circle = resolution.circles[0];
+      EXPECT_LT(camera.fit_max_error_px, 0.005 * circle.r) << where;
+      const double theta = preset.field_of_view_deg / 2 * kPi / 180 - 1e-6;
+      const bool wide = camera.width >= camera.height;
+      for (const double angle : {0.0, theta}) {
+        const Eigen::Vector3d ray(wide ? std::sin(angle) : 0,
+                                  wide ? 0 : std::sin(angle), std::cos(angle));
+        Eigen::Vector2d pixel;
+        ASSERT_TRUE(ImageFromRay(camera.model_id, camera.params, ray, &pixel))
+            << where;
+        const double radius =
+            (pixel - Eigen::Vector2d(circle.cx, circle.cy)).norm();
+        EXPECT_NEAR(radius, angle == 0 ? 0 : circle.r, 0.005 * circle.r)
+            << where << " at " << angle;
+      }
+      // In the rig config, every lens starts from it.
+      const nlohmann::json config = nlohmann::json::parse(
+          PresetRigConfigJson(preset, resolution, {}, model));
+      for (const auto& lens : config[0]["cameras"]) {
+        EXPECT_EQ(lens["camera_model_name"], model) << where;
+      }
+    }
+  }
+  // A model that is not a lens model, an unknown one, and a lens model for
+  // stitched panoramas are refused, naming the option.
+  const CameraPreset& theta = FindCameraPreset("ricoh_theta_v");
+  for (const std::string model : {"PINHOLE", "OPENCV", "EQUIRECTANGULAR",
+                                  "KB4"}) {
+    EXPECT_NE(PresetLensModelError(theta, model).find("--camera_model " + model +
+                                                      ": not a model for"),
+              std::string::npos)
+        << model;
+  }
+  EXPECT_EQ(PresetLensModelError(theta, ""), "");
+  RigPresetRequest stitched;
+  stitched.camera = "gopro_max";
+  stitched.camera_model = "EUCM";
+  EXPECT_NE(ErrorOf([&] { ResolveRigPreset(stitched); })
+                .find("stores stitched panoramas"),
+            std::string::npos);
+  stitched.camera_model = "EQUIRECTANGULAR";
+  EXPECT_EQ(ResolveRigPreset(stitched).model_name, "EQUIRECTANGULAR");
+  RigPresetRequest request;
+  request.camera = "ricoh_theta_v";
+  EXPECT_EQ(ResolveRigPreset(request).model_name, "DOUBLE_SPHERE");
+  request.camera_model = "OPENCV_FISHEYE";
+  EXPECT_EQ(ResolveRigPreset(request).model_name, "OPENCV_FISHEYE");
+  request.camera_model = "PINHOLE";
+  EXPECT_NE(ErrorOf([&] { ResolveRigPreset(request); }), "");
+}
+
 TEST(CameraPresets, CirclesAreConsistentPerResolution) {
   for (const CameraPreset& preset : CameraPresets()) {
     const std::vector<PresetResolution> resolutions = Resolutions(preset);

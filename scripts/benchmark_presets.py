@@ -36,6 +36,8 @@ Cameras (--cameras, comma separated):
 Usage (from the repository root, after scripts/build.sh):
   scripts/benchmark_presets.py                          5 seeds, theta
   scripts/benchmark_presets.py --cameras theta,insta360 --repeats 3
+  scripts/benchmark_presets.py --camera_model OPENCV_FISHEYE
+                                        the lenses start from that model
 Output (--output, default build/bench_presets): preset_runs.csv (every run),
 preset_results.csv (median and min..max per camera), preset_results.png,
 logs and the demo's folders under runs/.
@@ -290,10 +292,16 @@ def run_one(args, name, seed, work):
     env = dict(os.environ, SPHERA_DEMO_DIR=demo_dir,
                SPHERA_COLMAP=args.colmap, SPHERA_RENDER=args.render,
                SPHERA_DEMO_SEED=str(seed))
+    demo = [os.path.join(REPO, "scripts", "demo.sh"), "--camera", preset,
+            files]
+    if args.camera_model:
+        demo.append(args.camera_model)
     code, t_demo = common.run_logged(
-        [os.path.join(REPO, "scripts", "demo.sh"), "--camera", preset, files],
+        demo,
         os.path.join(logs, "demo.log"), 7200, env=env)
     row = {"camera": name, "preset": preset, "seed": seed,
+           "model": args.camera_model or nominal[0]["cameras"][0][
+               "camera_model_name"],
            "t_render_s": t_render, "t_demo_s": t_demo}
     with open(os.path.join(logs, "demo.log")) as f:
         output = f.read()
@@ -408,6 +416,9 @@ def main():
                         help="each lens's true rotation off the nominal rig")
     parser.add_argument("--lens_shift_mm", type=float, default=2.0,
                         help="each lens's true centre off the nominal rig")
+    parser.add_argument("--camera_model", default="",
+                        help="the lenses' starting model (demo.sh --camera "
+                        "NAME DIR MODEL; default: the preset's)")
     parser.add_argument("--half_field_deg", type=float, default=0,
                         help="the lenses' half field (0: the preset's)")
     parser.add_argument("--lens_size", type=int, nargs=2, default=None,

@@ -10,9 +10,14 @@
 #                                        scene rendered by sphera_render
 #                                        (SCENE/images) are evaluated against
 #                                        its ground truth (SCENE/sparse_gt)
-#   scripts/demo.sh --camera NAME DIR    a 360° camera's own files to a rig
+#   scripts/demo.sh --camera NAME DIR [MODEL]
+#                                        a 360° camera's own files to a rig
 #                                        model (colmap rig_preset --camera
-#                                        list names the cameras): the frames
+#                                        list names the cameras; MODEL: the
+#                                        lenses' starting model, default the
+#                                        preset's, e.g. OPENCV_FISHEYE for
+#                                        lenses of Kannala-Brandt
+#                                        calibrations): the frames
 #                                        split into lens images and masks
 #                                        (both lenses in one frame, or FR/ and
 #                                        BK/ folders), or the lens files read
@@ -56,12 +61,14 @@ readonly LOG="${WORK_DIR}/demo.log"
 readonly SEED="${SPHERA_DEMO_SEED:-0}"
 
 camera=""
+lens_model=""
 if [ "${1:-}" = "--camera" ]; then
-  if [ $# -ne 3 ]; then
-    echo "demo: usage: scripts/demo.sh --camera NAME DIR" >&2
+  if [ $# -ne 3 ] && [ $# -ne 4 ]; then
+    echo "demo: usage: scripts/demo.sh --camera NAME DIR [MODEL]" >&2
     exit 1
   fi
   camera="$2"
+  lens_model="${4:-}"
   shift 2
 fi
 image_dir="${1:-}"
@@ -161,6 +168,8 @@ start=$(date +%s)
 rig_config=""
 mask_args=()
 if [ -n "${camera}" ]; then
+  model_args=()
+  [ -z "${lens_model}" ] || model_args=(--camera_model "${lens_model}")
   # How the camera stores its lenses, from its line in the preset list.
   preset_line="$("${COLMAP}" rig_preset --camera list 2>/dev/null \
     | grep "^${camera}: " || true)"
@@ -172,11 +181,16 @@ if [ -n "${camera}" ]; then
     *"one file per lens"*)
       preset_kind=files
       run_stage "camera preset" 's/^$//p' "${COLMAP}" rig_preset \
-        --camera "${camera}" --output_path "${WORK_DIR}/preset_rig_config.json" ;;
+        --camera "${camera}" ${model_args[@]+"${model_args[@]}"} \
+        --output_path "${WORK_DIR}/preset_rig_config.json" ;;
     *) preset_kind=frames ;;
   esac
   case "${preset_kind}" in
     stitched)
+      # A lens model for stitched panoramas: rig_preset names the mistake.
+      [ -z "${lens_model}" ] || run_stage "camera preset" 's/^$//p' \
+        "${COLMAP}" rig_preset --camera "${camera}" "${model_args[@]}" \
+        --output_path "${WORK_DIR}/preset_rig_config.json"
       camera_model=EQUIRECTANGULAR
       echo "camera preset:      ${camera}: stitched panoramas, one camera" ;;
     files)
@@ -195,7 +209,7 @@ print(json.load(open(sys.argv[1]))[0]["cameras"][0]["camera_model_name"])' \
       # The generic preset's circles are a guess: the splitter finds the
       # circles in the frames instead, and the lenses start from the
       # preset's camera for the frames' size.
-      preset_args=(--camera "${camera}")
+      preset_args=(--camera "${camera}" ${model_args[@]+"${model_args[@]}"})
       if [ "${camera}" = dual_fisheye ]; then
         first_frame="$(find "${image_dir}" -maxdepth 1 -type f | sort | head -n 1)"
         frame_size="$(python3 -c 'import struct, sys
@@ -211,6 +225,7 @@ else:
 print(f"{w}x{h}")' "${first_frame}")"
         run_stage "camera preset" 's/^$//p' "${COLMAP}" rig_preset \
           --camera "${camera}" --resolution "${frame_size}" \
+          ${model_args[@]+"${model_args[@]}"} \
           --output_path "${WORK_DIR}/preset_rig_config.json"
         preset_args=($(python3 -c 'import json, sys
 c = json.load(open(sys.argv[1]))[0]["cameras"][0]

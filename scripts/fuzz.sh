@@ -307,8 +307,8 @@ distortion_coefficients: !!opencv-matrix
 }
 
 # Seeds of fuzz_camera_presets: the lines --camera, --resolution,
-# --image_width, --image_height and a resolution name, as rig_preset gets
-# them; written every run.
+# --image_width, --image_height, a resolution name and --camera_model, as
+# rig_preset gets them; written every run.
 make_preset_seeds() {
   local seeds="${WORK}/seeds/fuzz_camera_presets"
   mkdir -p "${seeds}"
@@ -317,6 +317,9 @@ make_preset_seeds() {
   printf 'dual_fisheye\n4000x2000\n\n\n8k\n' > "${seeds}/generic"
   printf 'VUZE\n\n\n\nlens\n' > "${seeds}/vuze"
   printf 'theta\n3k\n-1\n7\n0x0\n' > "${seeds}/bad"
+  printf 'ricoh_theta_v\n2k\n\n\n4k\nOPENCV_FISHEYE\n' > "${seeds}/kb_model"
+  printf 'vuze\n\n\n\nlens\nUNIFIED_OMNI\n' > "${seeds}/vuze_model"
+  printf 'gopro_max\n\n\n\nphoto\nEUCM\n' > "${seeds}/stitched_model"
 }
 
 # -- run --------------------------------------------------------------------

@@ -57,7 +57,8 @@ class RigPresetTest(TempDirTestCase):
         database = self.path("database.db")
         run_colmap("database_creator", "--database_path", database)
         connection = sqlite3.connect(database)
-        model_ids = {"DOUBLE_SPHERE": 65, "EUCM": 16, "EQUIRECTANGULAR": 17}
+        model_ids = {"DOUBLE_SPHERE": 65, "EUCM": 16, "EQUIRECTANGULAR": 17,
+                     "OPENCV_FISHEYE": 5}
         camera_id = image_id = 0
         for rig in rigs:
             cameras = rig["cameras"]
@@ -97,12 +98,17 @@ class RigPresetTest(TempDirTestCase):
         # Every preset's config, its images told apart from the others' by
         # a folder of the preset's name in front of the config's prefix:
         # one rig_configurator run applies them all.
+        # And the Vuze's lenses started from OPENCV_FISHEYE (--camera_model).
         rigs = []
-        for name in preset_names():
+        for name in preset_names() + ["vuze_kb"]:
             output = self.path(name + ".json")
             options = (["--resolution", "3840x1920"]
                        if name == "dual_fisheye" else [])
-            result = run_colmap("rig_preset", "--camera", name,
+            camera_name = name
+            if name == "vuze_kb":
+                camera_name = "vuze"
+                options = ["--camera_model", "OPENCV_FISHEYE"]
+            result = run_colmap("rig_preset", "--camera", camera_name,
                                 "--output_path", output, *options)
             self.assertIn("wrote " + output, result.stdout)
             with open(output) as f:
@@ -110,6 +116,9 @@ class RigPresetTest(TempDirTestCase):
             self.assertEqual(len(config), 1, name)
             for camera in config[0]["cameras"]:
                 camera["image_prefix"] = name + "/" + camera["image_prefix"]
+                if name == "vuze_kb":
+                    self.assertEqual(camera["camera_model_name"],
+                                     "OPENCV_FISHEYE")
             rigs.append(config[0])
         database = self.make_database(rigs)
         config_path = self.path("all_presets.json")
@@ -180,6 +189,34 @@ class RigPresetTest(TempDirTestCase):
             self.assertAlmostEqual(camera["camera_params"][3], circle[1],
                                    delta=0.5)
 
+        # --camera_model: the lenses start from that model, fitted to the
+        # same lens (its principal point on the circle's centre); with
+        # --camera_params, or a model that is no lens model, refused.
+        output_kb = self.path("split_kb")
+        run_colmap("dual_fisheye_splitter", "--input_path", self.path("raw"),
+                   "--output_path", output_kb, "--camera", "dual_fisheye",
+                   "--camera_model", "OPENCV_FISHEYE")
+        with open(os.path.join(output_kb, "rig_config.json")) as f:
+            kb_cameras = json.load(f)[0]["cameras"]
+        for camera in kb_cameras:
+            self.assertEqual(camera["camera_model_name"], "OPENCV_FISHEYE")
+            self.assertEqual(len(camera["camera_params"]), 8)
+            self.assertAlmostEqual(camera["camera_params"][2], circle[0],
+                                   delta=0.5)
+        for extra, needle in ((["--camera_model", "PINHOLE"],
+                               "--camera_model PINHOLE: not a model for"),
+                              (["--camera_model", "EUCM", "--camera_params",
+                                "1,2,3,4,0.5,1"], "not with --circles or "
+                               "--camera_params")):
+            refused = self.path("refused_model")
+            result = run_colmap("dual_fisheye_splitter", "--input_path",
+                                self.path("raw"), "--output_path", refused,
+                                "--camera", "dual_fisheye", *extra,
+                                check=False)
+            self.assertEqual(result.returncode, 1, extra)
+            self.assertIn(needle, result.stdout, extra)
+            self.assertFalse(os.path.exists(refused), extra)
+
         save(self.path("odd", "odd.png"),
              make_raw(5, circles=[circle, circle], width=size,
                       height=size - 8))
@@ -203,7 +240,12 @@ class RigPresetTest(TempDirTestCase):
                   "--image_height", "1500"],
                  ["1500x1500", "5.2k (2704x2624)"]),
                 (["--camera", "dual_fisheye", "--resolution", "5000x3000"],
-                 ["5000x3000", "W = 2 H"])):
+                 ["5000x3000", "W = 2 H"]),
+                (["--camera", "vuze", "--camera_model", "OPENCV"],
+                 ["--camera_model OPENCV: not a model for the lenses",
+                  "OPENCV_FISHEYE, THIN_PRISM_FISHEYE"]),
+                (["--camera", "gopro_max", "--camera_model", "EUCM"],
+                 ["gopro_max stores stitched panoramas"])):
             before = listing(self.tmp)
             result = run_colmap("rig_preset", *args, "--output_path", output,
                                 check=False)

@@ -890,14 +890,21 @@ void DualFisheyeSplittingOptions::Check() const {
                                 " exists and is not a folder");
   }
   ParseLensNames(lens_names);
-  CameraJson(camera_model, camera_params);
-  if (!camera.empty()) {
+  if (camera.empty()) {
+    CameraJson(camera_model, camera_params);
+  } else {
     const sphera::CameraPreset& preset = sphera::FindCameraPreset(camera);
-    if (!circles.empty() || !camera_model.empty()) {
+    if (!circles.empty() || !camera_params.empty()) {
       throw std::invalid_argument(
           "--camera " + camera +
-          " gives the circles and the lens model; not with --circles, "
-          "--camera_model or --camera_params");
+          " gives the circles and the lens parameters; not with --circles "
+          "or --camera_params (--camera_model alone picks the lenses' "
+          "starting model)");
+    }
+    if (const std::string error =
+            sphera::PresetLensModelError(preset, camera_model);
+        !error.empty()) {
+      throw std::invalid_argument(error);
     }
     if (preset.storage == sphera::LensStorage::kFilePerLens ||
         preset.storage == sphera::LensStorage::kEquirectangular ||
@@ -931,7 +938,9 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
   const std::array<std::string, 2> lens_names =
       ParseLensNames(options.lens_names);
   const std::string camera_json =
-      CameraJson(options.camera_model, options.camera_params);
+      options.camera.empty()
+          ? CameraJson(options.camera_model, options.camera_params)
+          : "";
   std::optional<std::array<ImageCircle, 2>> given_circles;
   if (!options.circles.empty()) {
     std::array<ImageCircle, 2> circles;
@@ -953,7 +962,8 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
     const auto& [circles, resolution] = *found;
     given_circles = circles;
     rig_config = sphera::PresetRigConfigJson(
-        preset, resolution, {lens_names[0], lens_names[1]});
+        preset, resolution, {lens_names[0], lens_names[1]},
+        options.camera_model);
     LOG(INFO) << "dual_fisheye_splitter: " << preset.name << " "
               << resolution.name << ": circles " << resolution.source;
   } else {
@@ -961,7 +971,7 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
   }
   const FrameScan scan =
       ScanFrames(frames, lens_names, given_circles, options.black_level);
-  if (!options.camera_model.empty()) {
+  if (options.camera.empty() && !options.camera_model.empty()) {
     // The lenses' camera as the mapper will check it, on the lens images'
     // size (a focal length of 0, a principal point far off the image).
     Camera camera;

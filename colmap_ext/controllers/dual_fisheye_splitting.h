@@ -59,14 +59,16 @@ struct DualFisheyeSplittingOptions {
   std::string circles;
   // A camera preset (rig_preset --camera list): its circles at the frames'
   // size (a size it does not know is refused) and its rig config (lens
-  // poses, the starting model), in place of circles, camera_model and
-  // camera_params.
+  // poses, the starting model), in place of circles and camera_params; with
+  // camera_model alone, the lenses start from that model fitted to the
+  // preset's lens (rig_preset --camera_model).
   std::string camera;
   // Intensity (8-bit scale) at or below which a pixel is black: pixels this
   // dark inside the circle at its rim say nothing about the frame, and a
   // circle on a black surround is located to the pixel.
   int black_level = 10;
-  // The camera of both lenses in rig_config.json (both or neither).
+  // The camera of both lenses in rig_config.json (both or neither; with
+  // camera, the model alone).
   std::string camera_model;
   std::string camera_params;
   int jpeg_quality = 95;

@@ -48,7 +48,9 @@ int RunDualFisheyeSplitter(int argc, char** argv) {
                            "pixel is black");
   options.AddDefaultOption("camera_model",
                            &splitting.camera_model,
-                           "camera of both lenses in rig_config.json");
+                           "camera of both lenses in rig_config.json "
+                           "(with --camera: the model its lenses start "
+                           "from)");
   options.AddDefaultOption("camera_params",
                            &splitting.camera_params,
                            "its parameters, comma-separated");

@@ -31,6 +31,10 @@ int RunRigPreset(int argc, char** argv) {
                            &request.image_width,
                            "the stored file's width (with image_height)");
   options.AddDefaultOption("image_height", &request.image_height);
+  options.AddDefaultOption("camera_model",
+                           &request.camera_model,
+                           "the lenses' starting model, fitted to the "
+                           "preset's lens (default: the preset's)");
   if (!options.Parse(argc, argv)) {
     return EXIT_FAILURE;
   }
@@ -60,12 +64,13 @@ int RunRigPreset(int argc, char** argv) {
     WriteTextFilesAtomically(
         folder,
         {{path.filename().string(),
-          sphera::PresetRigConfigJson(preset, resolved.resolution)}});
+          sphera::PresetRigConfigJson(preset, resolved.resolution, {},
+                                      resolved.model_name)}});
     std::cout << "rig_preset: " << preset.name << " ("
               << sphera::LensStorageName(preset.storage) << "), "
               << resolved.resolution.name << " " << resolved.resolution.width
               << "x" << resolved.resolution.height << ": "
-              << preset.lenses.size() << " lens(es), " << preset.model_name
+              << preset.lenses.size() << " lens(es), " << resolved.model_name
               << "; circles " << resolved.resolution.source << "; poses "
               << preset.source << "\nimages: "
               << (preset.storage == sphera::LensStorage::kFilePerLens

@@ -2,7 +2,8 @@
 // option checks (calibration/camera_presets.h) on any text. The input's
 // lines are the option values: --camera, --resolution, --image_width,
 // --image_height (the sizes read as OptionManager reads an int: a number,
-// else 0), then a name looked up as a resolution of every preset. An
+// else 0), then a name looked up as a resolution of every preset, then
+// --camera_model. An
 // std::invalid_argument is the expected outcome of bad values; any other
 // exception, a crash or undefined behaviour is not, and neither is an
 // accepted request whose circles, lens cameras or rig config break the
@@ -47,26 +48,29 @@ void CheckResolved(const sphera::ResolvedPreset& resolved) {
     }
   }
   static std::set<std::pair<std::string, std::string>> checked;
-  if (!checked.insert({preset.name, resolution.name}).second ||
+  if (!checked.insert({preset.name, resolution.name + " " +
+                                        resolved.model_name})
+           .second ||
       checked.size() > 64) {
     return;
   }
   for (size_t lens = 0; lens < preset.lenses.size(); ++lens) {
     const sphera::PresetCamera camera =
-        sphera::PresetLensCamera(preset, resolution, static_cast<int>(lens));
+        sphera::PresetLensCamera(preset, resolution, static_cast<int>(lens),
+                                 resolved.model_name);
     if (!sphera::CheckParams(camera.model_id, camera.params, camera.width,
                              camera.height)
              .empty()) {
       __builtin_trap();
     }
   }
-  sphera::PresetRigConfigJson(preset, resolution);
+  sphera::PresetRigConfigJson(preset, resolution, {}, resolved.model_name);
 }
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  std::vector<std::string> lines(5);
+  std::vector<std::string> lines(6);
   size_t line = 0;
   for (size_t i = 0; i < size && line < lines.size(); ++i) {
     if (data[i] == '\n') {
@@ -80,6 +84,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   request.resolution = lines[1];
   request.image_width = ParseInt(lines[2]);
   request.image_height = ParseInt(lines[3]);
+  request.camera_model = lines[5];
   try {
     CheckResolved(sphera::ResolveRigPreset(request));
   } catch (const std::invalid_argument&) {
