@@ -411,13 +411,12 @@ std::string PresetLensModelError(const CameraPreset& preset,
            " stores stitched panoramas, one " + preset.model_name +
            " camera";
   }
-  static const char* const kLensModels[] = {
-      "OPENCV_FISHEYE", "THIN_PRISM_FISHEYE", "EUCM",
-      "UNIFIED_OMNI",   "DOUBLE_SPHERE",      "OCAM"};
+  // The lens models: the sphere models but the panorama's.
   std::string known;
-  for (const char* name : kLensModels) {
-    if (model_name == name) return "";
-    known += std::string(known.empty() ? "" : ", ") + name;
+  for (const ModelInfo& info : SphereModels()) {
+    if (info.name == std::string("EQUIRECTANGULAR")) continue;
+    if (model_name == info.name) return "";
+    known += (known.empty() ? "" : ", ") + std::string(info.name);
   }
   return "--camera_model " + model_name +
          ": not a model for the lenses of a 360° camera; one of " + known;

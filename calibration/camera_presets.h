@@ -136,10 +136,10 @@ PresetCamera PresetLensCamera(const CameraPreset& preset,
                               const PresetResolution& resolution, int lens,
                               const std::string& model_name = "");
 
-// Why MODEL_NAME cannot start the lenses of PRESET (not a model of
-// registry.h, not one of the whole-field lens models OPENCV_FISHEYE,
-// THIN_PRISM_FISHEYE, EUCM, UNIFIED_OMNI, DOUBLE_SPHERE, OCAM, or a preset
-// of stitched panoramas), or "" (also for an empty name: the preset's).
+// Why MODEL_NAME cannot start the lenses of PRESET (not one of the
+// whole-field lens models, registry.h's SphereModels but EQUIRECTANGULAR, or
+// a preset of stitched panoramas), or "" (also for an empty name: the
+// preset's).
 std::string PresetLensModelError(const CameraPreset& preset,
                                  const std::string& model_name);
 
@@ -151,8 +151,9 @@ Eigen::Vector3d PresetCamFromRigTranslation(const CameraPreset& preset,
 
 // rig_configurator's rig_config.json for the preset at the resolution: one
 // rig, lens 0 the reference sensor, every lens with its camera model
-// (MODEL_NAME, empty: the preset's) and parameters and (except lens 0) its nominal cam_from_rig. Images are named
-// as the preset stores them after splitting: "FOLDER/NAME" with the folders
+// (MODEL_NAME, empty: the preset's) and parameters and (except lens 0) its
+// nominal cam_from_rig. Images are named as the preset stores them after
+// splitting: "FOLDER/NAME" with the folders
 // LENS_FOLDERS (empty: the preset's own), or NAME<file_suffix> for files
 // per lens.
 std::string PresetRigConfigJson(const CameraPreset& preset,

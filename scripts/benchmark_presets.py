@@ -43,7 +43,6 @@ preset_results.csv (median and min..max per camera), preset_results.png,
 logs and the demo's folders under runs/.
 """
 import argparse
-import csv
 import json
 import math
 import os
@@ -62,11 +61,12 @@ from benchmark_rig import (KB_COEFFICIENTS, fmt, kb_radius,  # noqa: E402
 REPO = common.REPO_ROOT
 
 # name: (preset, resolution, how the camera stores its lenses, the preset's
-# field of view in degrees)
+# field of view in degrees, the size of one lens image at the resolution)
 CAMERAS = {
-    "theta": ("ricoh_theta_v", "2k", "side_by_side", 202.0),
-    "insta360": ("insta360_one_x2", "4k", "side_by_side", 200.0),
-    "vuze": ("vuze", "", "files", 180.0),
+    "theta": ("ricoh_theta_v", "2k", "side_by_side", 202.0, (960, 960)),
+    "insta360": ("insta360_one_x2", "4k", "side_by_side", 200.0,
+                 (1920, 1920)),
+    "vuze": ("vuze", "", "files", 180.0, (1080, 1920)),
 }
 
 
@@ -91,10 +91,6 @@ def start_radius(model, params, theta):
     raise ValueError(f"starting model {model}: DOUBLE_SPHERE or EUCM")
 
 
-def quat_to_matrix(q):
-    return common.rotation_from_quaternion(*q)
-
-
 def random_turn(rng, angle_deg):
     """A rotation matrix of ANGLE_DEG about a random axis."""
     import numpy as np
@@ -106,17 +102,26 @@ def random_turn(rng, angle_deg):
     return np.eye(3) + math.sin(a) * k + (1 - math.cos(a)) * k @ k
 
 
-def true_rig(nominal, rng, turn_deg, shift_mm):
-    """[(folder, R cam_from_rig, lens centre in the rig)] of the true rig:
-    the nominal config's lenses, each but the first turned and moved."""
+def nominal_rig(nominal):
+    """[(camera, R cam_from_rig, lens centre in the rig)] of the lenses of
+    a rig_config.json list NOMINAL."""
     import numpy as np
     lenses = []
-    for k, camera in enumerate(nominal[0]["cameras"]):
-        rotation = quat_to_matrix(camera.get("cam_from_rig_rotation",
-                                             [1, 0, 0, 0]))
+    for camera in nominal[0]["cameras"]:
+        rotation = common.rotation_from_quaternion(
+            *camera.get("cam_from_rig_rotation", [1, 0, 0, 0]))
         translation = np.array(camera.get("cam_from_rig_translation",
                                           [0, 0, 0]), dtype=float)
-        centre = -rotation.T @ translation
+        lenses.append((camera, rotation, -rotation.T @ translation))
+    return lenses
+
+
+def true_rig(nominal_lenses, rng, turn_deg, shift_mm):
+    """nominal_rig's lenses, each but the first turned and moved: the true
+    rig."""
+    import numpy as np
+    lenses = []
+    for k, (camera, rotation, centre) in enumerate(nominal_lenses):
         if k > 0:
             rotation = random_turn(rng, turn_deg) @ rotation
             direction = np.array([rng.gauss(0, 1) for _ in range(3)])
@@ -231,7 +236,7 @@ def score(gt_path, model_path, lenses, storage, nominal_lenses):
         if per_frame_rot:
             rot_errors.append(common.median(per_frame_rot))
             centre_errors.append(common.median(per_frame_centre))
-        nominal_rotation, nominal_centre = nominal_lenses[k]
+        _, nominal_rotation, nominal_centre = nominal_lenses[k]
         relative = lenses[k][1] @ nominal_rotation.T
         start_rot.append(math.degrees(math.acos(
             max(-1.0, min(1.0, (np.trace(relative) - 1) / 2)))))
@@ -246,8 +251,7 @@ def score(gt_path, model_path, lenses, storage, nominal_lenses):
 
 
 def run_one(args, name, seed, work):
-    import numpy as np
-    preset, resolution, storage, field_of_view = CAMERAS[name]
+    preset, resolution, storage, field_of_view, lens_size = CAMERAS[name]
     os.makedirs(work)
     logs = os.path.join(work, "logs")
     os.makedirs(logs)
@@ -263,21 +267,11 @@ def run_one(args, name, seed, work):
     with open(nominal_path) as f:
         nominal = json.load(f)
     half_field = args.half_field_deg or field_of_view / 2
-    rng = random.Random(seed)
-    lenses = true_rig(nominal, rng, args.lens_turn_deg, args.lens_shift_mm)
-    nominal_lenses = []
-    for camera in nominal[0]["cameras"]:
-        rotation = quat_to_matrix(camera.get("cam_from_rig_rotation",
-                                             [1, 0, 0, 0]))
-        translation = np.array(camera.get("cam_from_rig_translation",
-                                          [0, 0, 0]), dtype=float)
-        nominal_lenses.append((rotation, -rotation.T @ translation))
-    size = (int(round(2 * nominal[0]["cameras"][0]["camera_params"][2])),
-            int(round(2 * nominal[0]["cameras"][0]["camera_params"][3])))
-    if args.lens_size:
-        size = tuple(args.lens_size)
+    nominal_lenses = nominal_rig(nominal)
+    lenses = true_rig(nominal_lenses, random.Random(seed),
+                      args.lens_turn_deg, args.lens_shift_mm)
     sensors = os.path.join(work, "sensors.txt")
-    sensors_file(lenses, size, half_field, sensors)
+    sensors_file(lenses, lens_size, half_field, sensors)
     scene = os.path.join(work, "scene")
     render = ["--rig_sensors", sensors, "--frames", args.frames, "--seed",
               seed, "--supersample", args.supersample, "--realistic"]
@@ -421,8 +415,6 @@ def main():
                         "NAME DIR MODEL; default: the preset's)")
     parser.add_argument("--half_field_deg", type=float, default=0,
                         help="the lenses' half field (0: the preset's)")
-    parser.add_argument("--lens_size", type=int, nargs=2, default=None,
-                        help=argparse.SUPPRESS)
     parser.add_argument("--output", default=os.path.join(REPO, "build",
                                                          "bench_presets"))
     args = parser.parse_args()

@@ -127,9 +127,8 @@ bool ShapeColour(uint64_t key_round, const Eigen::Vector2d& uv, double cell,
           SplitMix64(key_round ^ static_cast<uint64_t>(i)) ^ static_cast<uint64_t>(j));
       const uint64_t h_round = SplitMix64(h);
       // Hash(h, n): its rounds of c, d and e are plain rounds.
-      auto value = [h_round](uint64_t n) {
-        return UnitFromHash(SplitMix64(HashRest3(h_round ^ n)));
-      };
+      auto hash = [h_round](uint64_t n) { return SplitMix64(HashRest3(h_round ^ n)); };
+      auto value = [&hash](uint64_t n) { return UnitFromHash(hash(n)); };
       if (value(1) >= occupancy) continue;  // empty cell
       const double priority = value(2);
       if (priority <= best_priority) continue;
@@ -139,7 +138,7 @@ bool ShapeColour(uint64_t key_round, const Eigen::Vector2d& uv, double cell,
       const Eigen::Vector2d p = uv - centre;
       const double c = std::cos(angle), s = std::sin(angle);
       const double x = c * p.x() + s * p.y(), y = -s * p.x() + c * p.y();
-      const int type = static_cast<int>(SplitMix64(HashRest3(h_round ^ 7)) % 5);
+      const int type = static_cast<int>(hash(7) % 5);
       bool inside = false;
       switch (type) {
         case 0: inside = x * x + y * y < radius * radius; break;

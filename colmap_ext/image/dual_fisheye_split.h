@@ -91,10 +91,10 @@ cv::Mat BrightPixelMask(const cv::Mat& image, int black_level);
 // away from the circle, so that the lens's blurred edge counts for
 // neither): the rim is dark there when the darkest of three outside bands
 // side by side is at most 60% of the inside, or when the first of them is
-// at least the inside over 60% (a housing's bright rim). Three, so that a
-// circle given a
-// little inside the picture's edge (a conservative circle from a maker's
-// file, 1-3% of r) still finds the dark beyond it. Only directions whose
+// at least the inside over 60% and brighter than the last (a housing's
+// bright rim, fading outwards). Three, so that a circle given a little
+// inside the picture's edge (a conservative circle from a maker's file, 1-3%
+// of r) still finds the dark beyond it. Only directions whose
 // first outside band is in the image and whose inside band is brighter than
 // BLACK_LEVEL count; *NUM_DIRECTIONS (if not null) is set to their number,
 // and the fraction is 0 when there is none.
