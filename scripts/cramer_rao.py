@@ -212,11 +212,77 @@ def _perspective_params(model, p):
     return None
 
 
+def _kannala_brandt(model, p, x, yy, z):
+    """OPENCV_FISHEYE and THIN_PRISM_FISHEYE over their whole field
+    (camera_models/kannala_brandt.h): theta = atan2(|(x, y)|, z), the ray on
+    the theta plane (a, b) = theta (x, y) / |(x, y)|, then the radial (and
+    for THIN_PRISM_FISHEYE the tangential and thin-prism) terms."""
+    rho = np.hypot(x, yy)
+    theta = np.arctan2(rho, z)
+    on_axis = rho == 0
+    scale = np.where(on_axis, 0.0, theta / np.where(on_axis, 1.0, rho))
+    a, b = scale * x, scale * yy
+    t2 = theta * theta
+    if model == "OPENCV_FISHEYE":
+        k = p[4:8]
+        radial = t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3])))
+        ad, bd = a * (1 + radial), b * (1 + radial)
+    else:
+        k1, k2, p1, p2, k3, k4, sx1, sy1 = p[4:12]
+        radial = t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4)))
+        ad = (a + a * radial + 2 * p1 * a * b + p2 * (t2 + 2 * a * a) +
+              sx1 * t2)
+        bd = (b + b * radial + 2 * p2 * a * b + p1 * (t2 + 2 * b * b) +
+              sy1 * t2)
+    return np.stack([p[0] * ad + p[2], p[1] * bd + p[3]], axis=1)
+
+
+def _ocam(p, x, yy, z):
+    """OCAM (camera_models/ocam.h): the sensor radius rho in [0, rho_max)
+    whose ray atan2(rho, -f(rho)) has the ray's angle from +z (monotone
+    there; found by bisection to full precision), then OCamCalib's affine
+    map."""
+    a0, a2, a3, a4 = p[5:9]
+    f = lambda r: a0 + r * r * (a2 + r * (a3 + r * a4))  # noqa: E731
+    # rho_max: the first positive root of m(rho) = -f + rho f'.
+    roots = np.roots([3 * a4, 2 * a3, a2, 0, -a0]) if (a2, a3, a4) != (
+        0, 0, 0) else np.array([])
+    real = [r.real for r in roots if abs(r.imag) < 1e-12 and r.real > 0]
+    rho_xy = np.hypot(x, yy)
+    theta_ray = np.arctan2(rho_xy, z)
+    if real:
+        hi = np.full(len(x), min(real))
+    else:
+        hi = np.full(len(x), max(1.0, -a0))
+        for _ in range(2000):
+            short = np.arctan2(hi, -f(hi)) < theta_ray
+            if not short.any():
+                break
+            hi[short] *= 2
+    lo = np.zeros(len(x))
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        below = np.arctan2(mid, -f(mid)) < theta_ray
+        lo = np.where(below, mid, lo)
+        hi = np.where(below, hi, mid)
+    rho = 0.5 * (lo + hi)
+    on_axis = rho_xy == 0
+    q = np.where(on_axis, 0.0, rho / np.where(on_axis, 1.0, rho_xy))
+    s_col, s_row = q * x, q * yy
+    c, d, e = p[2], p[3], p[4]
+    return np.stack([e * s_row + s_col + p[0],
+                     c * s_row + d * s_col + p[1]], axis=1)
+
+
 def project(camera, y):
     """Pixels (K,2) of the rays y (K,3) in the camera (model, w, h, params),
     following camera_models/*.h."""
     model, _, _, p = camera
     x, yy, z = y[:, 0], y[:, 1], y[:, 2]
+    if model in ("OPENCV_FISHEYE", "THIN_PRISM_FISHEYE"):
+        return _kannala_brandt(model, p, x, yy, z)
+    if model == "OCAM":
+        return _ocam(p, x, yy, z)
     persp = _perspective_params(model, p)
     if persp is not None:
         fx, fy, cx, cy, k = persp

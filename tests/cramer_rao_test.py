@@ -196,7 +196,12 @@ class ProjectionTest(unittest.TestCase):
                        ("UNIFIED_OMNI", 1024, 1024,
                         [450, 450, 512, 512, 1.0, -0.1, 0.02, 1e-3, -1e-3]),
                        ("DOUBLE_SPHERE", 1024, 1024,
-                        [350, 350, 512, 512, -0.2, 0.6])]:
+                        [350, 350, 512, 512, -0.2, 0.6]),
+                       ("OPENCV_FISHEYE", 1024, 1024,
+                        [300, 300, 512, 512, -0.012, 0.0016, -0.0002, 0]),
+                       ("OCAM", 1024, 1024,
+                        [512, 500, 1.0005, 2e-4, -3e-4, -300, 1.25e-3,
+                         -9.7e-7, 2.5e-9])]:
             J = crb.projection_jacobian(camera, y)
             saved = crb.FD_STEP
             try:
@@ -575,6 +580,55 @@ class ReconstructionBoundTest(unittest.TestCase):
             f.write("\n".join(lines[:5]) + "\n")
         with self.assertRaises(ValueError):
             crb.reconstruction_scene(gt_path, est_path)
+
+
+class RenderedLensesTest(unittest.TestCase):
+    """project() against the C++ camera models: the renderer writes each
+    observation of its ground truth where camera_models/ puts the point, so
+    the bound of a scene drawn through a Kannala-Brandt or OCam lens (the
+    realistic rigs) rests on the same projection the renderer used."""
+
+    def test_projection_matches_the_renderer(self):
+        if not os.environ.get("SPHERA_RENDER"):
+            self.skipTest("SPHERA_RENDER (the built sphera_render) is not set")
+        import sphera_common as common
+        size = 320
+        c = size / 2.0
+        lenses = {
+            # 200 degrees, the realistic rigs' Kannala-Brandt shape.
+            "kb": ("OPENCV_FISHEYE", [90.5, 90.5, c, c, -0.012, 0.0016,
+                                      -0.0002, 0.0]),
+            "prism": ("THIN_PRISM_FISHEYE",
+                      [90.0, 91.0, c + 3, c - 2, -0.01, 0.001, 2e-4, -1e-4,
+                       -1e-4, 0.0, 3e-4, -2e-4]),
+            # A polynomial that folds at rho = 185 px, outside the image
+            # circle; slightly non-identity affine map.
+            "ocam": ("OCAM", [c + 1.5, c - 2.5, 1.0005, 2e-4, -3e-4, -37.5,
+                              0.01, -3.0e-5, 0.0]),
+        }
+        with tempfile.TemporaryDirectory() as work:
+            rig = os.path.join(work, "rig.txt")
+            common.write_rig(rig, [
+                common.rig_line(name, model, size, size, params,
+                                [0.3 * k, 0.0, 0.2], 40 * k, 10 * k)
+                for k, (name, (model, params)) in enumerate(lenses.items())])
+            scene_dir = os.path.join(work, "scene")
+            common.run_render(scene_dir, "--rig", rig, "--seed", 3,
+                              "--supersample", 1, "--points", 2000)
+            scene = crb.scene_from_model(os.path.join(scene_dir, "sparse_gt"))
+        for j, name in enumerate(scene.names):
+            rows = scene.obs_image == j
+            model = scene.cameras[scene.camera_ids[j]][0]
+            with self.subTest(model=model):
+                self.assertGreater(rows.sum(), 50, name)
+                y = crb.observation_rays(scene)[rows]
+                # Rays beyond 90 degrees from the axis are among them.
+                angles = np.degrees(np.arctan2(np.hypot(y[:, 0], y[:, 1]),
+                                               y[:, 2]))
+                self.assertGreater(angles.max(), 95, name)
+                error = np.abs(crb.projections(scene)[rows] -
+                               scene.observed[rows]).max()
+                self.assertLess(error, 1e-6, name)
 
 
 if __name__ == "__main__":
