@@ -28,7 +28,8 @@ Parameters
   Image j: omega_j (3) and C_j (3), with R_j <- exp([omega_j]x) R_j, so
   |omega_j| is the rotation error angle ||log(R_gt R_est^T)|| that the
   evaluator measures, and C_j the centre in world units.  Point i: X_i (3).
-  Intrinsics are fixed (known calibration).
+  Intrinsics are fixed (known calibration), except in the rig bound with
+  --intrinsics (below).
     d y / d omega = -[y]x,   d y / d C = -R,   d y / d X = R.
   Observation k (image j, point i) has whitened Jacobians
     A_k = M [-[y]x, -R] (2 x 6)  and  P_k = M R (2 x 3).
@@ -96,12 +97,28 @@ Reported bounds
   covariance (what the evaluator's mean error estimates; for an isotropic
   3D Gaussian E|e| = sqrt(8 / (3 pi)) sigma = 0.921 sigma).
 
+Rigs (--rig)
+  A rig's bundle adjustment estimates frames (R_f rig_from_world, C_f) and
+  each lens's pose in the rig (R_s sensor_from_rig, c_s its centre in the
+  rig), the reference lens fixed at the rig frame; image j, lens s of frame
+  f, is R_j = R_s R_f, C_j = C_f + R_f^T c_s.  To first order the image
+  errors are a linear map T of the rig's (rig_jacobian), so the rig's
+  reduced information is T^T S T (the points eliminated as before) and its
+  alignment K T; the world similarity moves the frames as cameras and
+  stretches the rig (dc_s = lambda c_s).  The bound of a lens's pose is
+  then what rig_errors measures: the angle of R_s and the distance of c_s,
+  scaled by the alignment.  With --intrinsics each lens's focal length and
+  distortion are parameters too (one block per lens, the principal point
+  held as COLMAP holds it by default); their derivatives are central
+  differences of the projection.
+
 Known points (closed-form checks): known_points_information gives the 6x6
 information of one camera's (omega, C) when the points are known exactly.
 """
 import argparse
 import csv
 import math
+import os
 import sys
 import time
 
@@ -109,8 +126,8 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse
 
-from sphera_common import (cam_from_world, read_text_model,
-                           similarity_of_centres)
+from sphera_common import (cam_from_world, read_text_model, read_text_rigs,
+                           read_text_rows, similarity_of_centres)
 
 FD_STEP = 1e-5  # central-difference step, relative to |y|
 GAUGES = ("centers", "orientations")
@@ -411,9 +428,43 @@ def projections(scene):
     return pixels
 
 
-def observation_jacobians(scene, sigma, noise):
+# The principal point's indices in a model's parameters (default (2, 3)).
+PRINCIPAL_POINT = {"SIMPLE_PINHOLE": (1, 2), "SIMPLE_RADIAL": (1, 2),
+                   "RADIAL": (1, 2), "OCAM": (0, 1), "EQUIRECTANGULAR": ()}
+
+
+def refined_intrinsics(model, num_params):
+    """Indices of the parameters that COLMAP's bundle adjustment refines by
+    default: focal length and distortion, the principal point held
+    (--Mapper.ba_refine_principal_point 0)."""
+    fixed = PRINCIPAL_POINT.get(model, (2, 3))
+    return [p for p in range(num_params) if p not in fixed]
+
+
+def intrinsics_jacobian(camera, y):
+    """d pi / d params (K,2,P) of the rays y (K,3) for the refined
+    parameters (refined_intrinsics): central differences, the step 1e-6 of
+    each parameter's size (at least 1e-6 for a parameter of 0, e.g. an
+    unused distortion term)."""
+    model, width, height, params = camera
+    params = np.asarray(params, dtype=float)
+    refined = refined_intrinsics(model, len(params))
+    J = np.empty((len(y), 2, len(refined)))
+    for column, p in enumerate(refined):
+        h = 1e-6 * max(abs(params[p]), 1.0)
+        up, down = params.copy(), params.copy()
+        up[p] += h
+        down[p] -= h
+        J[:, :, column] = (project((model, width, height, up), y) -
+                           project((model, width, height, down), y)) / (2 * h)
+    return J
+
+
+def observation_jacobians(scene, sigma, noise, intrinsics=False):
     """Whitened Jacobians of every observation: A (K,2,6) with respect to
-    (omega, C) of its image, P (K,2,3) with respect to its point."""
+    (omega, C) of its image, P (K,2,3) with respect to its point.  With
+    intrinsics (pixel noise; every camera of one model), A (K,2,6+P) also
+    holds the derivatives by its camera's P refined parameters."""
     R = scene.R[scene.obs_image]
     y = observation_rays(scene)
     M = np.empty((len(y), 2, 3))
@@ -424,6 +475,18 @@ def observation_jacobians(scene, sigma, noise):
             scene.cameras[camera_id], y[sel], sigma, noise)
     A = np.concatenate([-M @ skew(y), -M @ R], axis=2)
     P = M @ R
+    if intrinsics:
+        sizes = {len(refined_intrinsics(camera[0], len(camera[3])))
+                 for camera in scene.cameras.values()}
+        if noise != "pixel" or len(sizes) != 1:
+            raise ValueError("intrinsics are bounded for pixel noise and "
+                             "cameras of one model")
+        Ji = np.empty((len(y), 2, sizes.pop()))
+        for camera_id in np.unique(cams):
+            sel = cams == camera_id
+            Ji[sel] = intrinsics_jacobian(scene.cameras[camera_id],
+                                          y[sel]) / sigma
+        A = np.concatenate([A, Ji], axis=2)
     return A, P
 
 
@@ -435,9 +498,10 @@ def _sum_by(index, values, n):
     return (onehot @ values.reshape(K, -1)).reshape((n,) + values.shape[1:])
 
 
-def information_blocks(scene, sigma, noise):
-    """U (N,6,6), V (M,3,3) and W (K,6,3) of the Fisher information."""
-    A, P = observation_jacobians(scene, sigma, noise)
+def information_blocks(scene, sigma, noise, intrinsics=False):
+    """U (N,D,D), V (M,3,3) and W (K,D,3) of the Fisher information, D = 6
+    (6 + P with intrinsics, observation_jacobians)."""
+    A, P = observation_jacobians(scene, sigma, noise, intrinsics)
     At = np.transpose(A, (0, 2, 1))
     U = _sum_by(scene.obs_image, At @ A, scene.num_images)
     V = _sum_by(scene.obs_point, np.transpose(P, (0, 2, 1)) @ P,
@@ -472,20 +536,23 @@ def _block_sparse(blocks, rows, cols, shape):
         (blocks.ravel(), (r.ravel(), q.ravel())), shape=shape)
 
 
-def reduced_camera_information(scene, sigma, noise, chunk=2000):
-    """(S, Y, Vinv): S = U - W V^-1 W^T (6N x 6N), Y = W V^-1 (sparse,
-    6N x 3M) and the V_i^-1, over the points seen by at least two images.
+def reduced_camera_information(scene, sigma, noise, chunk=2000,
+                               intrinsics=False):
+    """(S, Y, Vinv): S = U - W V^-1 W^T (DN x DN: D = 6, 6 + P with
+    intrinsics), Y = W V^-1 (sparse, DN x 3M) and the V_i^-1, over the
+    points seen by at least two images.
     S is accumulated over chunks of points as dense products, which BLAS
     does faster than a sparse product with a dense result."""
-    U, V, W = information_blocks(scene, sigma, noise)
+    U, V, W = information_blocks(scene, sigma, noise, intrinsics)
     N, Mp = scene.num_images, scene.num_points
+    D = U.shape[1]
     track = np.bincount(scene.obs_point, minlength=Mp)
     keep = track[scene.obs_point] >= 2
     Vinv = np.zeros_like(V)
     good = track >= 2
     Vinv[good] = np.linalg.inv(V[good])
     Wm = _block_sparse(W[keep], scene.obs_image[keep],
-                       scene.obs_point[keep], (6 * N, 3 * Mp)).tocsc()
+                       scene.obs_point[keep], (D * N, 3 * Mp)).tocsc()
     Vm = _block_sparse(Vinv, np.arange(Mp), np.arange(Mp), (3 * Mp, 3 * Mp))
     Y = (Wm @ Vm).tocsc()
     S = scipy.linalg.block_diag(*U)
@@ -747,6 +814,204 @@ def bound_for_reconstruction(gt_dir, model_dir, gauge="centers",
 
 
 # ---------------------------------------------------------------------------
+# Rigs
+
+class Rig:
+    """How the images of a scene are the lenses of a rig: per image (arrays
+    over the scene's images) its frame index and sensor index; per frame
+    R_f (rig_from_world) and C_f (the rig frame's origin in the world); per
+    sensor its camera id, R_s (sensor_from_rig), c_s (its centre in the rig
+    frame) and whether it is a rig's reference sensor (the rig frame itself:
+    R_s = I, c_s = 0, not a parameter)."""
+
+    def __init__(self, image_frame, image_sensor, R_f, C_f, camera_ids, R_s,
+                 c_s, reference):
+        self.image_frame = np.asarray(image_frame, dtype=int)
+        self.image_sensor = np.asarray(image_sensor, dtype=int)
+        self.R_f = np.asarray(R_f, dtype=float).reshape(-1, 3, 3)
+        self.C_f = np.asarray(C_f, dtype=float).reshape(-1, 3)
+        self.camera_ids = list(camera_ids)
+        self.R_s = np.asarray(R_s, dtype=float).reshape(-1, 3, 3)
+        self.c_s = np.asarray(c_s, dtype=float).reshape(-1, 3)
+        self.reference = np.asarray(reference, dtype=bool)
+
+    @property
+    def num_frames(self):
+        return len(self.R_f)
+
+    def free_sensors(self):
+        """Indices of the sensors whose pose in the rig is a parameter."""
+        return np.flatnonzero(~self.reference)
+
+
+def rig_of_scene(scene, gt_dir):
+    """The Rig of the scene's images from the ground truth's rigs.txt and
+    frames.txt (COLMAP 4 text): the images of one frame are its lenses; a
+    frame's pose follows from any of its images and that lens's pose in the
+    rig."""
+    rigs = read_text_rigs(gt_dir)
+    frame_of_image = {}
+    for fields in read_text_rows(os.path.join(gt_dir, "frames.txt")):
+        data = fields[10:]
+        for k in range(0, len(data), 3):
+            if data[k] == "CAMERA":
+                frame_of_image[int(data[k + 2])] = int(fields[0])
+    reference_ids = set()
+    for fields in read_text_rows(os.path.join(gt_dir, "rigs.txt")):
+        if int(fields[1]) > 0 and fields[2] == "CAMERA":
+            reference_ids.add(int(fields[3]))
+    image_frame, image_sensor, frames, sensors = [], [], {}, {}
+    R_f, C_f, R_s, c_s, reference = [], [], [], [], []
+    for j, image_id in enumerate(scene.image_ids):
+        camera_id = int(scene.camera_ids[j])
+        frame_id = frame_of_image.get(image_id)
+        pose = next((rig[camera_id] for rig in rigs.values()
+                     if rig.get(camera_id) is not None), None)
+        if frame_id is None or pose is None:
+            raise ValueError("image %s is in no frame of a rig with a pose "
+                             "of its camera in %s" % (scene.names[j], gt_dir))
+        if camera_id not in sensors:
+            sensors[camera_id] = len(sensors)
+            R_s.append(pose[0])
+            c_s.append(-pose[0].T @ pose[1])
+            reference.append(camera_id in reference_ids)
+        s = sensors[camera_id]
+        if frame_id not in frames:
+            frames[frame_id] = len(frames)
+            rotation = R_s[s].T @ scene.R[j]                 # R_f = R_s^T R_j
+            R_f.append(rotation)
+            C_f.append(scene.C[j] - rotation.T @ c_s[s])
+        image_frame.append(frames[frame_id])
+        image_sensor.append(s)
+    return Rig(image_frame, image_sensor, R_f, C_f, list(sensors), R_s, c_s,
+               reference)
+
+
+def rig_jacobian(rig):
+    """T (6N x 6F + 6S'): the image errors (omega_j, dC_j) of small
+    changes of the frames (omega_f, dC_f) and of the free sensors
+    (omega_s, dc_s), with R_f <- exp([omega_f]x) R_f, C_f <- C_f + dC_f,
+    R_s <- exp([omega_s]x) R_s, c_s <- c_s + dc_s.  Image j (sensor s of
+    frame f) has R_j = R_s R_f and C_j = C_f + R_f^T c_s, so to first order
+      omega_j = R_s omega_f + omega_s,
+      dC_j = dC_f + R_f^T [c_s]x omega_f + R_f^T dc_s."""
+    N, F = len(rig.image_frame), rig.num_frames
+    free = rig.free_sensors()
+    column_of_sensor = np.full(len(rig.reference), -1)
+    column_of_sensor[free] = 6 * F + 6 * np.arange(len(free))
+    T = np.zeros((6 * N, 6 * F + 6 * len(free)))
+    for j in range(N):
+        f, s = rig.image_frame[j], rig.image_sensor[j]
+        rows, frame = 6 * j, 6 * f
+        T[rows:rows + 3, frame:frame + 3] = rig.R_s[s]
+        T[rows + 3:rows + 6, frame:frame + 3] = rig.R_f[f].T @ skew(
+            rig.c_s[s])
+        T[rows + 3:rows + 6, frame + 3:frame + 6] = np.eye(3)
+        if column_of_sensor[s] >= 0:
+            c = column_of_sensor[s]
+            T[rows:rows + 3, c:c + 3] = np.eye(3)
+            T[rows + 3:rows + 6, c + 3:c + 6] = rig.R_f[f].T
+    return T
+
+
+def rig_gauge_generators(rig):
+    """G (6F + 6S', 7): the world similarity (theta, tau, lambda about the
+    mean image centre c, as gauge_generators) on the rig's parameters:
+    frames as cameras (omega_f = -R_f theta, dC_f = theta x d_f + tau +
+    lambda d_f, d_f = C_f - c), free sensors omega_s = 0, dc_s = lambda c_s
+    (the scale stretches the rig)."""
+    F = rig.num_frames
+    C_images = rig.C_f[rig.image_frame] + np.einsum(
+        "jba,jb->ja", rig.R_f[rig.image_frame], rig.c_s[rig.image_sensor])
+    c = C_images.mean(axis=0)
+    frames = np.zeros((F, 6, 7))
+    frames[:, 0:3, 0:3] = -rig.R_f
+    d = rig.C_f - c
+    frames[:, 3:6, 0:3] = -skew(d)
+    frames[:, 3:6, 3:6] = np.eye(3)
+    frames[:, 3:6, 6] = d
+    free = rig.free_sensors()
+    sensors = np.zeros((len(free), 6, 7))
+    sensors[:, 3:6, 6] = rig.c_s[free]
+    return np.concatenate([frames.reshape(6 * F, 7),
+                           sensors.reshape(6 * len(free), 7)])
+
+
+def rig_bound(scene, rig, sigma, noise="pixel", gauge="centers",
+              intrinsics=False):
+    """Bound of the rig's free sensors (rotation and centre in the rig) and
+    of its frames when the poses are estimated as a rig (frames and sensor
+    poses, as the mapper's rig bundle adjustment does) instead of one pose
+    per image: the images' reduced camera information S in the rig's
+    parameters, T^T S T (T = rig_jacobian; a linear change of the image
+    parameters, so eliminating the points first changes nothing), with the
+    evaluator's alignment of the image centres, K T.  Returns {sensors:
+    [{camera_id, name, rot_deg, centre}] (sqrt of the traces; centre in
+    model units), frame_rot_rms_deg, frame_pos_rms, covariance, counts}.
+    With intrinsics each lens's P camera parameters are estimated too
+    (self-calibration; pixel noise): they follow the rig's parameters, one
+    block per sensor, shared by the sensor's images."""
+    check_alignable(scene, gauge)
+    S, _, _ = reduced_camera_information(scene, sigma, noise,
+                                         intrinsics=intrinsics)
+    T = rig_jacobian(rig)
+    K = alignment_map(scene, gauge)
+    if intrinsics:
+        N, R = scene.num_images, T.shape[1]
+        D = S.shape[0] // N
+        P = D - 6
+        T_images, K_images = T, K
+        T = np.zeros((D * N, R + P * len(rig.reference)))
+        K = np.zeros((7, D * N))
+        for j in range(N):
+            s = rig.image_sensor[j]
+            T[D * j:D * j + 6, :R] = T_images[6 * j:6 * j + 6]
+            T[D * j + 6:D * j + D, R + P * s:R + P * s + P] = np.eye(P)
+            K[:, D * j:D * j + 6] = K_images[:, 6 * j:6 * j + 6]
+    cov = gauge_covariance(T.T @ S @ T, K @ T)
+    F = rig.num_frames
+    first_image = {s: j for j, s in reversed(list(enumerate(
+        rig.image_sensor)))}
+    sensors = []
+    for k, s in enumerate(rig.free_sensors()):
+        block = cov[6 * F + 6 * k:6 * F + 6 * k + 6,
+                    6 * F + 6 * k:6 * F + 6 * k + 6]
+        sensors.append({
+            "camera_id": rig.camera_ids[s],
+            "name": scene.names[first_image[s]].split("/")[0],
+            "rot_deg": math.degrees(math.sqrt(max(np.trace(block[:3, :3]),
+                                                  0))),
+            "centre": math.sqrt(max(np.trace(block[3:, 3:]), 0))})
+    rot = [np.trace(cov[6 * f:6 * f + 3, 6 * f:6 * f + 3]) for f in range(F)]
+    pos = [np.trace(cov[6 * f + 3:6 * f + 6, 6 * f + 3:6 * f + 6])
+           for f in range(F)]
+    return {"sensors": sensors, "num_frames": F, "covariance": cov,
+            "frame_rot_rms_deg": math.degrees(math.sqrt(max(np.mean(rot),
+                                                            0))),
+            "frame_pos_rms": math.sqrt(max(np.mean(pos), 0)),
+            "num_images": scene.num_images, "num_points": scene.num_points,
+            "num_observations": len(scene.obs_image), "sigma": sigma,
+            "noise": noise, "gauge": gauge, "intrinsics": intrinsics}
+
+
+def format_rig_report(result):
+    lines = ["Rig bound: %d frames (%d images), %d points, %d observations, "
+             "%s noise sigma = %.4g, gauge: %s alignment, intrinsics %s" % (
+                 result["num_frames"], result["num_images"],
+                 result["num_points"], result["num_observations"],
+                 result["noise"], result["sigma"], result["gauge"],
+                 "estimated" if result["intrinsics"] else "known"),
+             "%9s  %-12s  %14s  %14s" % ("camera_id", "lens",
+                                         "rotation (deg)", "centre")]
+    for r in result["sensors"]:
+        lines.append("%9d  %-12s  %14.6g  %14.6g" % (
+            r["camera_id"], r["name"][:12], r["rot_deg"], r["centre"]))
+    lines.append("frames RMS:             rot %.6g deg, pos %.6g" % (
+        result["frame_rot_rms_deg"], result["frame_pos_rms"]))
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------
 # Command line
 
 def format_report(result):
@@ -807,7 +1072,18 @@ def main(argv=None):
                         "bound its own tracks in the ground-truth poses, "
                         "pixel noise estimated from its residuals unless "
                         "--sigma_px is given")
-    parser.add_argument("--csv", help="write the per-image table here")
+    parser.add_argument("--rig", action="store_true",
+                        help="bound the scene as a rig (the ground truth's "
+                        "rigs.txt and frames.txt): each lens's rotation and "
+                        "centre in the rig and the frames, as a rig's bundle "
+                        "adjustment estimates them")
+    parser.add_argument("--intrinsics", action="store_true",
+                        help="with --rig: the lenses' focal lengths and "
+                        "distortion are estimated too (self-calibration, the "
+                        "principal point held as COLMAP's bundle adjustment "
+                        "holds it by default), not known")
+    parser.add_argument("--csv", help="write the per-image (with --rig: "
+                        "per-lens) table here")
     args = parser.parse_args(argv)
     noise = args.noise or ("angle" if args.sigma_deg is not None
                            else "pixel")
@@ -820,9 +1096,24 @@ def main(argv=None):
                               args.sigma_deg is not None) or not sigma > 0):
         parser.error("give one positive --sigma_px (pixel noise) or "
                      "--sigma_deg (angle noise)")
+    if args.intrinsics and not args.rig:
+        parser.error("--intrinsics bounds a rig's self-calibration: give "
+                     "--rig too")
     start = time.time()
     try:
-        if args.model:
+        if args.rig:
+            if args.model:
+                scene, estimated = reconstruction_scene(args.gt_model,
+                                                        args.model)
+                print("pixel noise estimated from the model's residuals: "
+                      "%.4g px" % estimated)
+                sigma = sigma or estimated
+            else:
+                scene = scene_from_model(args.gt_model)
+                sigma = math.radians(sigma) if noise == "angle" else sigma
+            result = rig_bound(scene, rig_of_scene(scene, args.gt_model),
+                               sigma, noise, args.gauge, args.intrinsics)
+        elif args.model:
             result = bound_for_reconstruction(args.gt_model, args.model,
                                               args.gauge, sigma)
             print("pixel noise estimated from the model's residuals: "
@@ -833,9 +1124,16 @@ def main(argv=None):
     except (OSError, ValueError) as e:
         print("error: %s" % e, file=sys.stderr)
         return 1
-    print(format_report(result))
+    print(format_rig_report(result) if args.rig else format_report(result))
     print("time %.2f s" % (time.time() - start))
-    if args.csv:
+    if args.csv and args.rig:
+        with open(args.csv, "w", newline="") as f:
+            writer = csv.writer(f)
+            writer.writerow(["camera_id", "lens", "rot_deg", "centre"])
+            for r in result["sensors"]:
+                writer.writerow([r["camera_id"], r["name"], r["rot_deg"],
+                                 r["centre"]])
+    elif args.csv:
         write_csv(result, args.csv)
     return 0
 

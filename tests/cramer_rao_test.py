@@ -582,6 +582,166 @@ class ReconstructionBoundTest(unittest.TestCase):
             crb.reconstruction_scene(gt_path, est_path)
 
 
+# ---------------------------------------------------------------------------
+# Rigs
+
+KB_LENS = [150.0, 150.0, 400.0, 400.0, -0.012, 0.0016, -0.0002, 0.0]
+
+
+def dual_fisheye_rig_scene(num_frames=6, num_points=400, seed=5):
+    """(scene, rig): two 200-degree Kannala-Brandt lenses back to back, 3 cm
+    apart (lens 1 turned 180 degrees about y, its centre at z = -3 cm in
+    the rig), on frames along a path in a shell of points 1.5 to 4 m
+    away; a lens sees the points within 100 degrees of its axis."""
+    rng = np.random.default_rng(seed)
+    R_s = [np.eye(3), Rotation.from_euler("y", 180, degrees=True).as_matrix()]
+    c_s = [np.zeros(3), np.array([0.0, 0.0, -0.03])]
+    R_f = [Rotation.from_euler("yxz", [rng.uniform(0, 360), rng.normal(0, 5),
+                                       rng.normal(0, 5)],
+                               degrees=True).as_matrix()
+           for _ in range(num_frames)]
+    C_f = np.stack([np.linspace(-0.6, 0.6, num_frames),
+                    rng.normal(0, 0.05, num_frames),
+                    rng.normal(0, 0.3, num_frames)], axis=1)
+    X = rng.normal(size=(num_points, 3))
+    X *= (rng.uniform(1.5, 4, num_points) / np.linalg.norm(X, axis=1))[:, None]
+    R, C, camera_ids, names, frame, sensor = [], [], [], [], [], []
+    obs_image, obs_point = [], []
+    for f in range(num_frames):
+        for s in range(2):
+            j = len(R)
+            R.append(R_s[s] @ R_f[f])
+            C.append(C_f[f] + R_f[f].T @ c_s[s])
+            camera_ids.append(s + 1)
+            names.append("lens%d/frame%03d.jpg" % (s, f))
+            frame.append(f)
+            sensor.append(s)
+            y = (X - C[j]) @ R[j].T
+            angle = np.degrees(np.arctan2(np.hypot(y[:, 0], y[:, 1]), y[:, 2]))
+            seen = np.flatnonzero(angle < 100)
+            obs_image += [j] * len(seen)
+            obs_point += list(seen)
+    cameras = {1: ("OPENCV_FISHEYE", 800, 800, KB_LENS),
+               2: ("OPENCV_FISHEYE", 800, 800, KB_LENS)}
+    scene = crb.Scene(cameras, range(1, len(R) + 1), names, camera_ids, R, C,
+                      range(1, num_points + 1), X, obs_image, obs_point)
+    rig = crb.Rig(frame, sensor, R_f, C_f, [1, 2], R_s, c_s, [True, False])
+    return scene, rig
+
+
+def write_rig_files(rig, scene, path):
+    """rigs.txt and frames.txt (COLMAP 4 text) of the rig, beside the
+    images.txt of write_text_model."""
+    def pose(R, t):
+        x, y, z, w = Rotation.from_matrix(R).as_quat()
+        return " ".join(map(repr, [w, x, y, z, *t]))
+    free = rig.free_sensors()
+    with open(os.path.join(path, "rigs.txt"), "w") as f:
+        f.write("1 %d CAMERA %d %s\n" % (
+            len(rig.reference), rig.camera_ids[0], " ".join(
+                "CAMERA %d 1 %s" % (rig.camera_ids[s], pose(
+                    rig.R_s[s], -rig.R_s[s] @ rig.c_s[s])) for s in free)))
+    with open(os.path.join(path, "frames.txt"), "w") as f:
+        for frame in range(rig.num_frames):
+            images = np.flatnonzero(rig.image_frame == frame)
+            f.write("%d 1 %s %d %s\n" % (
+                frame + 1, pose(rig.R_f[frame], -rig.R_f[frame] @
+                                rig.C_f[frame]), len(images), " ".join(
+                    "CAMERA %d %d" % (scene.camera_ids[j], scene.image_ids[j])
+                    for j in images)))
+
+
+class RigBoundTest(unittest.TestCase):
+    def test_rig_jacobian_is_the_first_order_change(self):
+        scene, rig = dual_fisheye_rig_scene()
+        T = crb.rig_jacobian(rig)
+        rng = np.random.default_rng(2)
+        delta = rng.normal(size=T.shape[1]) * 1e-6
+        F = rig.num_frames
+        moved_R_f = [Rotation.from_rotvec(delta[6 * f:6 * f + 3]).as_matrix()
+                     @ rig.R_f[f] for f in range(F)]
+        moved_C_f = [rig.C_f[f] + delta[6 * f + 3:6 * f + 6]
+                     for f in range(F)]
+        sensor = delta[6 * F:6 * F + 6]
+        moved_R_s = [rig.R_s[0], Rotation.from_rotvec(sensor[:3]).as_matrix()
+                     @ rig.R_s[1]]
+        moved_c_s = [rig.c_s[0], rig.c_s[1] + sensor[3:]]
+        expected = T @ delta
+        for j in range(scene.num_images):
+            f, s = rig.image_frame[j], rig.image_sensor[j]
+            R = moved_R_s[s] @ moved_R_f[f]
+            C = moved_C_f[f] + moved_R_f[f].T @ moved_c_s[s]
+            omega = Rotation.from_matrix(R @ scene.R[j].T).as_rotvec()
+            np.testing.assert_allclose(omega, expected[6 * j:6 * j + 3],
+                                       atol=1e-11)
+            np.testing.assert_allclose(C - scene.C[j],
+                                       expected[6 * j + 3:6 * j + 6],
+                                       atol=1e-11)
+
+    def test_the_world_similarity_moves_the_rig_as_it_moves_the_images(self):
+        scene, rig = dual_fisheye_rig_scene()
+        G = crb.rig_gauge_generators(rig)
+        np.testing.assert_allclose(crb.rig_jacobian(rig) @ G,
+                                   crb.gauge_generators(scene), atol=1e-12)
+        S, _, _ = crb.reduced_camera_information(scene, 0.5, "pixel")
+        T = crb.rig_jacobian(rig)
+        residual = np.abs(T.T @ S @ T @ G).max()
+        self.assertLess(residual, 1e-6 * np.abs(T.T @ S @ T).max())
+
+    def test_one_lens_rig_is_the_image_bound(self):
+        scene = ring_scene(8, 60, seed=3)
+        rig = crb.Rig(range(8), [0] * 8, scene.R, scene.C, [1], [np.eye(3)],
+                      [np.zeros(3)], [True])
+        images = crb.scene_bound(scene, 0.5, points=False)
+        frames = crb.rig_bound(scene, rig, 0.5)
+        self.assertAlmostEqual(frames["frame_rot_rms_deg"] /
+                               images["rot_rms_deg"], 1, delta=1e-9)
+        self.assertAlmostEqual(frames["frame_pos_rms"] / images["pos_rms"], 1,
+                               delta=1e-9)
+        self.assertEqual(frames["sensors"], [])
+
+    def test_a_rig_bounds_its_frames_at_most_as_its_images(self):
+        # The rig is the images' model with lens 1's poses tied to the
+        # frames': a restriction, so no frame's bound can grow.
+        scene, rig = dual_fisheye_rig_scene()
+        images = crb.scene_bound(scene, 0.5, points=False)["covariance"]
+        result = crb.rig_bound(scene, rig, 0.5)
+        frames = result["covariance"]
+        for f in range(rig.num_frames):
+            j = int(np.flatnonzero((rig.image_frame == f) &
+                                   (rig.image_sensor == 0))[0])
+            self.assertLessEqual(np.trace(frames[6 * f:6 * f + 6,
+                                                 6 * f:6 * f + 6]),
+                                 np.trace(images[6 * j:6 * j + 6,
+                                                 6 * j:6 * j + 6]))
+        (lens,) = result["sensors"]
+        self.assertEqual((lens["camera_id"], lens["name"]), (2, "lens1"))
+        self.assertGreater(lens["rot_deg"], 0)
+        # Estimating the lenses' focal lengths and distortion too can only
+        # loosen the bound.
+        calibrated = crb.rig_bound(scene, rig, 0.5, intrinsics=True)
+        self.assertGreater(calibrated["sensors"][0]["centre"], lens["centre"])
+        self.assertGreater(calibrated["sensors"][0]["rot_deg"],
+                           lens["rot_deg"])
+
+    def test_command_line_reads_the_rig_of_a_text_model(self):
+        scene, rig = dual_fisheye_rig_scene()
+        with tempfile.TemporaryDirectory() as tmp:
+            write_text_model(scene, tmp)
+            write_rig_files(rig, scene, tmp)
+            read = crb.rig_of_scene(crb.scene_from_model(tmp), tmp)
+            np.testing.assert_array_equal(read.image_frame, rig.image_frame)
+            np.testing.assert_allclose(read.c_s, rig.c_s, atol=1e-12)
+            np.testing.assert_allclose(read.C_f, rig.C_f, atol=1e-12)
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out):
+                self.assertEqual(crb.main(["--gt_model", tmp, "--sigma_px",
+                                           "0.5", "--rig", "--intrinsics"]),
+                                 0)
+            self.assertIn("lens1", out.getvalue())
+            self.assertIn("intrinsics estimated", out.getvalue())
+
+
 class RenderedLensesTest(unittest.TestCase):
     """project() against the C++ camera models: the renderer writes each
     observation of its ground truth where camera_models/ puts the point, so
