@@ -138,12 +138,13 @@ ParsedCamera LensCamera(const std::string& name,
     camera.model_id = static_cast<int>(exact->first);
     camera.params = exact->second;
   } else {
-    camera.sample_lens = [lens, width, height]() {
+    camera.sample_lens = [lens, width,
+                          height](const LensSamplingOptions& sampling) {
       return SampleLensByProjection(
           [&lens](const Eigen::Vector3d& ray, Eigen::Vector2d* pixel) {
             return lens.ImageFromRay(ray, pixel);
           },
-          width, height);
+          width, height, sampling);
     };
   }
   return camera;
@@ -269,6 +270,17 @@ ImportedCalibration ImportCalibrationText(
           "THIN_PRISM_FISHEYE, EUCM, UNIFIED_OMNI, DOUBLE_SPHERE, OCAM)");
     }
   }
+  if (!(options.half_field_deg >= 0 && options.half_field_deg <= 180)) {
+    std::ostringstream message;
+    message << "--half_field_deg: " << options.half_field_deg
+            << " is not an angle from the optical axis in [0, 180] degrees "
+               "(0: the whole image frame)";
+    throw std::invalid_argument(message.str());
+  }
+  LensSamplingOptions sampling;
+  if (options.half_field_deg > 0) {
+    sampling.max_angle_deg = options.half_field_deg;
+  }
   ImportedCalibration calibration;
   calibration.file = file_name;
   calibration.format = options.format;
@@ -334,9 +346,9 @@ ImportedCalibration ImportCalibrationText(
             [id, &params](const Eigen::Vector3d& ray, Eigen::Vector2d* pixel) {
               return ImageFromRay(id, params, ray, pixel);
             },
-            camera.width, camera.height);
+            camera.width, camera.height, sampling);
       } else {
-        samples = parsed_camera.sample_lens();
+        samples = parsed_camera.sample_lens(sampling);
       }
       if (samples.size() < 20) {
         throw CalibrationError(

@@ -76,6 +76,10 @@ struct CalibrationImportOptions {
   // A model name of camera_models/registry.h to convert every camera to;
   // empty: the file's model where it is one of ours, else the nearest.
   std::string camera_model;
+  // The lens's half field of view in degrees (a circular fisheye's image
+  // circle); a fit to another model uses only the rays within it. 0: every
+  // ray the image frame holds, up to the lens's fold.
+  double half_field_deg = 0;
 };
 
 // Reads the file; throws CalibrationError.

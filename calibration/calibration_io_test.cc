@@ -197,6 +197,48 @@ TEST(OpenCV, FisheyeYaml) {
   EXPECT_TRUE(calibration.notes.empty());
 }
 
+// A 200-degree circular fisheye: the Kannala-Brandt shape of the realistic
+// rigs, its image circle (radius 491.5 px at 100 degrees) inside a
+// 1024 x 1024 frame whose corners the polynomial maps to 156 degrees.
+constexpr char kCircularFisheyeYaml[] = R"(%YAML:1.0
+---
+image_width: 1024
+image_height: 1024
+fisheye_model: 1
+camera_matrix: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 289.54, 0., 512., 0., 289.54, 512., 0., 0., 1. ]
+distortion_coefficients: !!opencv-matrix
+   rows: 4
+   cols: 1
+   dt: d
+   data: [ -0.012, 0.0016, -0.0002, 0. ]
+)";
+
+TEST(OpenCV, AFitKeepsToTheHalfFieldItIsGiven) {
+  CalibrationImportOptions options;
+  options.camera_model = "DOUBLE_SPHERE";
+  const std::string path = WriteFile("circular.yml", kCircularFisheyeYaml);
+  const ImportedCamera whole_frame =
+      ImportCalibrationFile(path, options).cameras[0];
+  options.half_field_deg = 100;
+  const ImportedCamera circle = ImportCalibrationFile(path, options).cameras[0];
+  ASSERT_TRUE(whole_frame.fit.has_value());
+  ASSERT_TRUE(circle.fit.has_value());
+  EXPECT_GT(whole_frame.fit->max_angle_deg, 150);
+  EXPECT_LE(circle.fit->max_angle_deg, 100);
+  EXPECT_GT(circle.fit->max_angle_deg, 99);
+  // Fitted where the lens images, DOUBLE_SPHERE follows it within a few
+  // tenths of a pixel; pulled towards the black corners it does not.
+  EXPECT_LT(circle.fit->max_error_px, 0.5);
+  EXPECT_GT(whole_frame.fit->max_error_px, 1.0);
+
+  options.half_field_deg = 200;
+  EXPECT_THROW(ImportCalibrationFile(path, options), std::invalid_argument);
+}
+
 TEST(OpenCV, OmnidirXml) {
   const ImportedCalibration calibration = Import("omni.xml", R"(<?xml version="1.0"?>
 <opencv_storage>

@@ -28,7 +28,8 @@ struct ParsedCamera {
   int model_id = -1;
   std::vector<double> params;
   // Otherwise the samples of the lens, for a fit.
-  std::function<std::vector<RayPixelSample>()> sample_lens;
+  std::function<std::vector<RayPixelSample>(const LensSamplingOptions&)>
+      sample_lens;
   std::optional<Eigen::Quaterniond> cam_from_rig_rotation;
   Eigen::Vector3d cam_from_rig_translation = Eigen::Vector3d::Zero();
 };

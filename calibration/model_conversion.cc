@@ -163,7 +163,9 @@ std::vector<RayPixelSample> SampleLensByProjection(
     double last_distance = 0;
     for (int step = 1;; ++step) {
       const double angle = step * options.step_deg * kDegree;
-      if (angle >= internal::kPi) break;
+      if (angle >= internal::kPi || angle > options.max_angle_deg * kDegree) {
+        break;
+      }
       const Eigen::Vector3d ray(std::sin(angle) * std::cos(azimuth),
                                 std::sin(angle) * std::sin(azimuth),
                                 std::cos(angle));
@@ -212,6 +214,7 @@ std::vector<RayPixelSample> SampleLensByUnprojection(
           std::atan2(ray.cross(samples.front().ray_in_cam).norm(),
                      ray.dot(samples.front().ray_in_cam));
       if (!(angle > last_angle)) break;  // folds
+      if (angle > options.max_angle_deg * kDegree) break;
       last_angle = angle;
       if (step % keep_every == 0) samples.push_back({ray, pixel});
     }

@@ -69,6 +69,10 @@ struct LensSamplingOptions {
   double sample_spacing_deg = 2.0;
   double step_px = 0.5;
   double sample_spacing_px = 12.0;
+  // Rays further from the optical axis are not sampled (degrees): a
+  // circular fisheye's half field, so that a fit describes the lens where it
+  // images and not the frame's corners beyond its image circle.
+  double max_angle_deg = 180;
 };
 
 // Samples of the lens by projection: the optical axis must be visible.

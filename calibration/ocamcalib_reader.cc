@@ -122,12 +122,13 @@ ParsedFile ReadOCamCalib(const std::string& text, const std::string& file) {
                      0};
     for (size_t i = 2; i < pol.size(); ++i) camera.params[4 + i] = pol[i];
   } else {
-    camera.sample_lens = [lens, width, height]() {
+    camera.sample_lens = [lens, width,
+                          height](const LensSamplingOptions& sampling) {
       return SampleLensByUnprojection(
           [&lens](const Eigen::Vector2d& pixel, Eigen::Vector3d* ray) {
             return lens.RayFromImage(pixel, ray);
           },
-          Eigen::Vector2d(lens.cx, lens.cy), width, height);
+          Eigen::Vector2d(lens.cx, lens.cy), width, height, sampling);
     };
   }
   ParsedFile parsed;

@@ -337,6 +337,15 @@ class CalibrationImporterTest(TempDirTestCase):
             line = [l for l in f if not l.startswith("#")][0].split()
         self.assertEqual(line[1:4], ["OPENCV_FISHEYE", "1280", "960"])
 
+        # Given the lens's half field, the fit keeps to it.
+        stdout, _ = self.run_importer(path, "--camera_model",
+                                      "OPENCV_FISHEYE", "--half_field_deg",
+                                      "80")
+        fit = re.search(r"rays up to ([\d.]+) deg from the axis", stdout)
+        self.assertIsNotNone(fit, stdout)
+        self.assertLessEqual(float(fit.group(1)), 80)
+        self.assertGreater(float(fit.group(1)), 78)
+
     def test_basalt(self):
         stdout, output = self.run_importer(
             self.write("calibration.json", json.dumps(BASALT, indent=1)))
@@ -379,6 +388,8 @@ class CalibrationImporterTest(TempDirTestCase):
              "basalt_missing.json: resolution: has 1 entries"),
             ("unknown_model.yaml", KALIBR, ["--camera_model", "FISHEYE9000"],
              "--camera_model: FISHEYE9000"),
+            ("half_field.yaml", KALIBR, ["--half_field_deg", "200"],
+             "--half_field_deg: 200 is not an angle"),
             ("anything.txt", "no calibration here\n", [],
              "anything.txt: format: "),
         ]

@@ -47,6 +47,7 @@ int RunCalibrationImporter(int argc, char** argv) {
   std::string format = "auto";
   std::string camera_model;
   std::string output_path;
+  double half_field_deg = 0;
 
   OptionManager options;
   options.AddRequiredOption("input_path", &input_path);
@@ -54,6 +55,10 @@ int RunCalibrationImporter(int argc, char** argv) {
                            "{auto, kalibr, opencv, ocamcalib, basalt}");
   options.AddDefaultOption("camera_model", &camera_model,
                            "a model of ours to convert every camera to");
+  options.AddDefaultOption("half_field_deg", &half_field_deg,
+                           "the lens's half field of view (a circular "
+                           "fisheye's image circle): a fit uses only rays "
+                           "within it; 0: the whole image frame");
   options.AddDefaultOption("output_path", &output_path);
   if (!options.Parse(argc, argv)) {
     return EXIT_FAILURE;
@@ -66,6 +71,7 @@ int RunCalibrationImporter(int argc, char** argv) {
     sphera::CalibrationImportOptions import_options;
     import_options.format = sphera::CalibrationFormatFromName(format);
     import_options.camera_model = camera_model;
+    import_options.half_field_deg = half_field_deg;
     const sphera::ImportedCalibration calibration =
         sphera::ImportCalibrationFile(input_path, import_options);
 
