@@ -93,4 +93,28 @@ void DivergedCameraHold::HoldDiverged(const DatabaseCache& database_cache,
   }
 }
 
+std::unordered_set<camera_t> DivergedCameraHold::ConstantIntrinsics(
+    const Reconstruction& reconstruction,
+    const FlatHashMap<camera_t, size_t>& num_reg_images_per_camera,
+    const IntrinsicsDivergenceOptions& options) const {
+  std::unordered_set<camera_t> constant = held_ids_;
+  for (const auto& [rig_id, rig] : reconstruction.Rigs()) {
+    if (rig.NumSensors() < 2) {
+      continue;
+    }
+    for (const sensor_t& sensor_id : rig.SensorIds()) {
+      if (sensor_id.type != SensorType::CAMERA) {
+        continue;
+      }
+      const auto found = num_reg_images_per_camera.find(sensor_id.id);
+      const size_t num_images =
+          found == num_reg_images_per_camera.end() ? 0 : found->second;
+      if (num_images < static_cast<size_t>(options.min_rig_frames)) {
+        constant.insert(sensor_id.id);
+      }
+    }
+  }
+  return constant;
+}
+
 }  // namespace colmap

@@ -8,6 +8,7 @@
 #include "colmap/scene/camera.h"
 #include "colmap/scene/database_cache.h"
 #include "colmap/scene/reconstruction.h"
+#include "colmap/util/hash_containers.h"
 
 #include <string>
 #include <unordered_map>
@@ -22,6 +23,12 @@ struct IntrinsicsDivergenceOptions {
   double max_focal_ratio = 4.0;
   // A camera with fx = fy in its prior may end with fx / fy this far from 1.
   double max_aspect_change = 0.2;
+  // A lens of a rig of several sensors keeps its intrinsics until this many
+  // registered frames show it (DivergedCameraHold::ConstantIntrinsics); 0,
+  // the default: refined from the start, as upstream does. Measured on the
+  // real GoPro Fusion photos (docs/rigs.md), 3 helps a Kannala-Brandt start
+  // and hurts the DOUBLE_SPHERE one, so it is not the default.
+  int min_rig_frames = 0;
 };
 
 // Empty when `refined` is a plausible refinement of `prior` (the same
@@ -55,8 +62,20 @@ class DivergedCameraHold {
                     const IntrinsicsDivergenceOptions& options,
                     Reconstruction* reconstruction);
 
-  bool IsHeld(camera_t camera_id) const { return held_ids_.count(camera_id); }
-  const std::unordered_set<camera_t>& Ids() const { return held_ids_; }
+  // The cameras whose intrinsics the next bundle adjustment keeps constant:
+  // the held ones, and each lens of a rig of several sensors that fewer
+  // than `options.min_rig_frames` registered frames show
+  // (`num_reg_images_per_camera`: the mapper's count of registered images
+  // per camera; a lens has one image per frame). A rig's lens is seen once
+  // per frame, so after the initial frame pair its intrinsics (a
+  // Kannala-Brandt lens: 8 parameters) rest on two views of a short
+  // baseline, and the first adjustments bend them; released from the
+  // min_rig_frames-th frame on, they are refined with the whole model.
+  // Cameras of one-sensor rigs are refined from the start, as upstream does.
+  std::unordered_set<camera_t> ConstantIntrinsics(
+      const Reconstruction& reconstruction,
+      const FlatHashMap<camera_t, size_t>& num_reg_images_per_camera,
+      const IntrinsicsDivergenceOptions& options) const;
   // In the order they were held.
   const std::vector<HeldCamera>& Held() const { return held_; }
 

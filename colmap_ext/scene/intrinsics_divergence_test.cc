@@ -83,9 +83,13 @@ TEST(DivergedCameraHold, SetsBackHoldsAndNamesARunaway) {
   reconstruction.Camera(2).params[0] = 97205;
   hold.HoldDiverged(database_cache, IntrinsicsDivergenceOptions(),
                     &reconstruction);
-  EXPECT_TRUE(hold.IsHeld(1));
-  // A camera without a prior is not judged.
-  EXPECT_FALSE(hold.IsHeld(2));
+  // Held whatever the number of frames; a camera without a prior is not
+  // judged.
+  const FlatHashMap<camera_t, size_t> num_images = {{1, 10}, {2, 10}};
+  IntrinsicsDivergenceOptions options;
+  options.min_rig_frames = 0;
+  EXPECT_EQ(hold.ConstantIntrinsics(reconstruction, num_images, options),
+            std::unordered_set<camera_t>{1});
   EXPECT_EQ(reconstruction.Camera(1).params, prior.params);
   ASSERT_EQ(hold.Held().size(), 1);
   EXPECT_EQ(hold.Held()[0].camera.params, prior.params);
@@ -98,6 +102,43 @@ TEST(DivergedCameraHold, SetsBackHoldsAndNamesARunaway) {
                     &reconstruction);
   EXPECT_EQ(reconstruction.Camera(1).params[0], 5000);
   EXPECT_EQ(hold.Held().size(), 1);
+}
+
+TEST(DivergedCameraHold, RigLensesAreReleasedFromTheirNthFrame) {
+  Reconstruction reconstruction;
+  for (camera_t camera_id = 1; camera_id <= 4; ++camera_id) {
+    Camera camera = MakeCamera("EUCM", {280, 280, 512, 512, 0.6, 1.0});
+    camera.camera_id = camera_id;
+    reconstruction.AddCamera(camera);
+  }
+  // Cameras 1 and 2 are the lenses of one rig; 3 and 4 are cameras alone.
+  Rig rig;
+  rig.SetRigId(1);
+  rig.AddRefSensor(sensor_t(SensorType::CAMERA, 1));
+  rig.AddSensor(sensor_t(SensorType::CAMERA, 2), Rigid3d());
+  reconstruction.AddRig(rig);
+  for (camera_t camera_id = 3; camera_id <= 4; ++camera_id) {
+    Rig single;
+    single.SetRigId(camera_id);
+    single.AddRefSensor(sensor_t(SensorType::CAMERA, camera_id));
+    reconstruction.AddRig(single);
+  }
+
+  const DivergedCameraHold hold;
+  // Lens 1 in two registered frames, lens 2 in three; camera 3 in one
+  // image, camera 4 in none: cameras alone are never kept constant here.
+  const FlatHashMap<camera_t, size_t> num_images = {{1, 2}, {2, 3}, {3, 1}};
+  const auto constant = [&](const FlatHashMap<camera_t, size_t>& num_images,
+                            int min_rig_frames) {
+    IntrinsicsDivergenceOptions options;
+    options.min_rig_frames = min_rig_frames;
+    return hold.ConstantIntrinsics(reconstruction, num_images, options);
+  };
+  EXPECT_EQ(constant(num_images, 3), std::unordered_set<camera_t>{1});
+  EXPECT_EQ(constant(num_images, 4), (std::unordered_set<camera_t>{1, 2}));
+  // A lens not registered yet counts as none; 0 releases every lens.
+  EXPECT_EQ(constant({{1, 5}}, 1), std::unordered_set<camera_t>{2});
+  EXPECT_TRUE(constant({}, 0).empty());
 }
 
 }  // namespace
