@@ -284,6 +284,20 @@ class CalibrationImporterTest(TempDirTestCase):
                             -0.0001])
         # One camera: no rig config.
         self.assertEqual(sorted(os.listdir(output)), ["cameras.txt"])
+        # An output folder that does not exist yet is made; one whose
+        # parent does not exist is named.
+        new = self.path("new_folder")
+        run_colmap("calibration_importer", "--input_path",
+                   self.write("fisheye2.yml", OPENCV_FISHEYE),
+                   "--output_path", new)
+        self.assertEqual(os.listdir(new), ["cameras.txt"])
+        result = run_colmap("calibration_importer", "--input_path",
+                            self.write("fisheye3.yml", OPENCV_FISHEYE),
+                            "--output_path", self.path("no/such"),
+                            check=False)
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("--output_path " + self.path("no/such"), result.stdout)
+        self.assertFalse(os.path.exists(self.path("no")))
 
         stdout, _ = self.run_importer(self.write("omni.xml", OPENCV_OMNIDIR))
         cameras = image_reader_options(stdout)

@@ -63,7 +63,10 @@ int RunCalibrationImporter(int argc, char** argv) {
   if (!options.Parse(argc, argv)) {
     return EXIT_FAILURE;
   }
-  if (!output_path.empty() && !ExistsDir(output_path)) {
+  // A folder that does not exist yet is made when there is something to
+  // write (command_line_paths.cc checks that its parent exists).
+  if (!output_path.empty() && ExistsPath(output_path) &&
+      !ExistsDir(output_path)) {
     LOG(ERROR) << "output_path: " << output_path << " is not a directory";
     return EXIT_FAILURE;
   }
@@ -97,6 +100,7 @@ int RunCalibrationImporter(int argc, char** argv) {
     std::vector<std::pair<std::string, std::string>> files = {
         {"cameras.txt", sphera::CamerasText(calibration)}};
     if (rig) files.emplace_back("rig_config.json", RigConfigJson(calibration));
+    std::filesystem::create_directory(output_path);
     WriteTextFilesAtomically(output_path, files);
     for (const auto& file : files) {
       std::cout << "wrote "

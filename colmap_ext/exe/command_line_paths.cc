@@ -83,8 +83,8 @@ std::string CommandLinePaths::MissingDatabaseError() const {
 
 std::string CommandLinePaths::MissingPaths() const {
   static const std::set<std::string> kCommandsCreatingOutput = {
-      "dual_fisheye_splitter", "image_undistorter", "rig_preset",
-      "sphere_bundle_adjuster", "sphere_undistorter"};
+      "calibration_importer", "dual_fisheye_splitter", "image_undistorter",
+      "rig_preset", "sphere_bundle_adjuster", "sphere_undistorter"};
   const bool creates_output = kCommandsCreatingOutput.count(command_) > 0;
   const std::string kPath = "_path";
   const std::string kOutputPath = "output_path";

@@ -66,11 +66,19 @@ TEST_F(CommandLinePathsTest, MissingPaths) {
                 .MissingPaths(),
             "paths that do not exist: --input_path " + missing_ +
                 ", --output_path " + (dir_ / "new").string());
-  // A command that creates its output folder.
-  EXPECT_EQ(Parse("image_undistorter", {"--output_path",
-                                        (dir_ / "new").string()})
-                .MissingPaths(),
-            "");
+  // Commands that create their output folder, in an existing one.
+  for (const std::string command : {"image_undistorter",
+                                    "calibration_importer"}) {
+    EXPECT_EQ(Parse(command, {"--output_path", (dir_ / "new").string()})
+                  .MissingPaths(),
+              "")
+        << command;
+    EXPECT_EQ(Parse(command, {"--output_path", (dir_ / "a" / "b").string()})
+                  .MissingPaths(),
+              "paths that do not exist: --output_path " +
+                  (dir_ / "a" / "b").string())
+        << command;
+  }
   // An option without a value.
   EXPECT_EQ(Parse("mapper", {"--input_path"}).MissingPaths(), "");
 }
