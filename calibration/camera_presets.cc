@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <map>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 
 #include <nlohmann/json.hpp>
@@ -504,6 +506,7 @@ std::string PresetRigConfigJson(const CameraPreset& preset,
         " folders were given");
   }
   nlohmann::ordered_json cameras = nlohmann::ordered_json::array();
+  std::map<std::tuple<double, double, double>, PresetCamera> fitted_lenses;
   for (size_t lens = 0; lens < preset.lenses.size(); ++lens) {
     nlohmann::ordered_json camera;
     if (preset.storage == LensStorage::kFilePerLens) {
@@ -527,9 +530,20 @@ std::string PresetRigConfigJson(const CameraPreset& preset,
       camera["cam_from_rig_translation"] = {Clean(t.x()), Clean(t.y()),
                                             Clean(t.z())};
     }
-    const PresetCamera lens_camera =
-        PresetLensCamera(preset, resolution, static_cast<int>(lens),
-                         model_name);
+    // Lenses of one image circle are one fit (the Vuze's eight).
+    const PresetCircle circle = lens < resolution.circles.size()
+                                    ? resolution.circles[lens]
+                                    : PresetCircle();
+    const auto key = std::make_tuple(circle.cx, circle.cy, circle.r);
+    auto fitted = fitted_lenses.find(key);
+    if (fitted == fitted_lenses.end()) {
+      fitted = fitted_lenses
+                   .emplace(key, PresetLensCamera(preset, resolution,
+                                                  static_cast<int>(lens),
+                                                  model_name))
+                   .first;
+    }
+    const PresetCamera& lens_camera = fitted->second;
     camera["camera_model_name"] = lens_camera.model_name;
     camera["camera_params"] = lens_camera.params;
     cameras.push_back(camera);
