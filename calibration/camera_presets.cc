@@ -3,10 +3,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <map>
 #include <sstream>
 #include <stdexcept>
-#include <tuple>
 #include <utility>
 
 #include <nlohmann/json.hpp>
@@ -471,6 +469,27 @@ PresetCamera PresetLensCamera(const CameraPreset& preset,
   return camera;
 }
 
+std::vector<PresetCamera> PresetLensCameras(const CameraPreset& preset,
+                                            const PresetResolution& resolution,
+                                            const std::string& model_name) {
+  std::vector<PresetCamera> cameras;
+  for (size_t lens = 0; lens < preset.lenses.size(); ++lens) {
+    // A lens of an earlier lens's image circle is that lens's fit.
+    size_t same = 0;
+    while (same < lens && lens < resolution.circles.size() &&
+           !(resolution.circles[same].cx == resolution.circles[lens].cx &&
+             resolution.circles[same].cy == resolution.circles[lens].cy &&
+             resolution.circles[same].r == resolution.circles[lens].r)) {
+      ++same;
+    }
+    cameras.push_back(same < lens ? cameras[same]
+                                  : PresetLensCamera(preset, resolution,
+                                                     static_cast<int>(lens),
+                                                     model_name));
+  }
+  return cameras;
+}
+
 Eigen::Quaterniond PresetCamFromRigRotation(const CameraPreset& preset,
                                             int lens) {
   Eigen::Quaterniond q = (preset.lenses.at(lens).body_from_cam.conjugate() *
@@ -505,8 +524,9 @@ std::string PresetRigConfigJson(const CameraPreset& preset,
         " lenses, but " + std::to_string(lens_folders.size()) +
         " folders were given");
   }
+  const std::vector<PresetCamera> lens_cameras =
+      PresetLensCameras(preset, resolution, model_name);
   nlohmann::ordered_json cameras = nlohmann::ordered_json::array();
-  std::map<std::tuple<double, double, double>, PresetCamera> fitted_lenses;
   for (size_t lens = 0; lens < preset.lenses.size(); ++lens) {
     nlohmann::ordered_json camera;
     if (preset.storage == LensStorage::kFilePerLens) {
@@ -530,20 +550,7 @@ std::string PresetRigConfigJson(const CameraPreset& preset,
       camera["cam_from_rig_translation"] = {Clean(t.x()), Clean(t.y()),
                                             Clean(t.z())};
     }
-    // Lenses of one image circle are one fit (the Vuze's eight).
-    const PresetCircle circle = lens < resolution.circles.size()
-                                    ? resolution.circles[lens]
-                                    : PresetCircle();
-    const auto key = std::make_tuple(circle.cx, circle.cy, circle.r);
-    auto fitted = fitted_lenses.find(key);
-    if (fitted == fitted_lenses.end()) {
-      fitted = fitted_lenses
-                   .emplace(key, PresetLensCamera(preset, resolution,
-                                                  static_cast<int>(lens),
-                                                  model_name))
-                   .first;
-    }
-    const PresetCamera& lens_camera = fitted->second;
+    const PresetCamera& lens_camera = lens_cameras[lens];
     camera["camera_model_name"] = lens_camera.model_name;
     camera["camera_params"] = lens_camera.params;
     cameras.push_back(camera);

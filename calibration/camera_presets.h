@@ -136,6 +136,12 @@ PresetCamera PresetLensCamera(const CameraPreset& preset,
                               const PresetResolution& resolution, int lens,
                               const std::string& model_name = "");
 
+// The cameras of every lens of PRESET, in order; lenses of one image circle
+// (a Vuze's eight) are fitted once.
+std::vector<PresetCamera> PresetLensCameras(const CameraPreset& preset,
+                                            const PresetResolution& resolution,
+                                            const std::string& model_name = "");
+
 // Why MODEL_NAME cannot start the lenses of PRESET (not one of the
 // whole-field lens models, registry.h's SphereModels but EQUIRECTANGULAR, or
 // a preset of stitched panoramas), or "" (also for an empty name: the

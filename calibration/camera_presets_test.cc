@@ -79,6 +79,22 @@ double RadiusOfRay(const PresetCamera& camera, const PresetCircle& circle,
   return (pixel - Eigen::Vector2d(circle.cx, circle.cy)).norm();
 }
 
+TEST(CameraPresets, LensCamerasAreEachLensInOrder) {
+  for (const CameraPreset& preset : CameraPresets()) {
+    const PresetResolution resolution = Resolutions(preset).front();
+    const std::vector<PresetCamera> cameras =
+        PresetLensCameras(preset, resolution);
+    ASSERT_EQ(cameras.size(), preset.lenses.size()) << preset.name;
+    for (size_t lens = 0; lens < cameras.size(); ++lens) {
+      const PresetCamera alone =
+          PresetLensCamera(preset, resolution, static_cast<int>(lens));
+      EXPECT_EQ(cameras[lens].params, alone.params)
+          << preset.name << " lens " << lens;
+      EXPECT_EQ(cameras[lens].width, alone.width) << preset.name;
+    }
+  }
+}
+
 TEST(CameraPresets, EveryLensModelPassesItsChecks) {
   for (const CameraPreset& preset : CameraPresets()) {
     for (const PresetResolution& resolution : Resolutions(preset)) {

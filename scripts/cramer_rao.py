@@ -914,29 +914,6 @@ def rig_jacobian(rig):
     return T
 
 
-def rig_gauge_generators(rig):
-    """G (6F + 6S', 7): the world similarity (theta, tau, lambda about the
-    mean image centre c, as gauge_generators) on the rig's parameters:
-    frames as cameras (omega_f = -R_f theta, dC_f = theta x d_f + tau +
-    lambda d_f, d_f = C_f - c), free sensors omega_s = 0, dc_s = lambda c_s
-    (the scale stretches the rig)."""
-    F = rig.num_frames
-    C_images = rig.C_f[rig.image_frame] + np.einsum(
-        "jba,jb->ja", rig.R_f[rig.image_frame], rig.c_s[rig.image_sensor])
-    c = C_images.mean(axis=0)
-    frames = np.zeros((F, 6, 7))
-    frames[:, 0:3, 0:3] = -rig.R_f
-    d = rig.C_f - c
-    frames[:, 3:6, 0:3] = -skew(d)
-    frames[:, 3:6, 3:6] = np.eye(3)
-    frames[:, 3:6, 6] = d
-    free = rig.free_sensors()
-    sensors = np.zeros((len(free), 6, 7))
-    sensors[:, 3:6, 6] = rig.c_s[free]
-    return np.concatenate([frames.reshape(6 * F, 7),
-                           sensors.reshape(6 * len(free), 7)])
-
-
 def rig_bound(scene, rig, sigma, noise="pixel", gauge="centers",
               intrinsics=False):
     """Bound of the rig's free sensors (rotation and centre in the rig) and

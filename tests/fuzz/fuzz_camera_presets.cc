@@ -54,17 +54,8 @@ void CheckResolved(const sphera::ResolvedPreset& resolved) {
       checked.size() > 64) {
     return;
   }
-  for (size_t lens = 0; lens < preset.lenses.size(); ++lens) {
-    // Lenses of the first lens's image circle are the same fit.
-    if (lens > 0 && lens < resolution.circles.size() &&
-        resolution.circles[lens].cx == resolution.circles[0].cx &&
-        resolution.circles[lens].cy == resolution.circles[0].cy &&
-        resolution.circles[lens].r == resolution.circles[0].r) {
-      continue;
-    }
-    const sphera::PresetCamera camera =
-        sphera::PresetLensCamera(preset, resolution, static_cast<int>(lens),
-                                 resolved.model_name);
+  for (const sphera::PresetCamera& camera : sphera::PresetLensCameras(
+           preset, resolution, resolved.model_name)) {
     if (!sphera::CheckParams(camera.model_id, camera.params, camera.width,
                              camera.height)
              .empty()) {
