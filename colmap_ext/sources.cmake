@@ -14,6 +14,7 @@ set(SPHERA_COLMAP_CONTROLLER_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/controllers/option_values.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/rig_calibration.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/rig_direction_check.cc
+  ${CMAKE_CURRENT_LIST_DIR}/controllers/rig_model_merge.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_bundle_adjustment.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_undistortion.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/strecha_import.cc)

@@ -1,5 +1,6 @@
 #include "estimators/similarity_alignment.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -115,6 +116,77 @@ bool AlignCentersWithRotation(const std::vector<Eigen::Vector3d>& src_centers,
   *tgt_from_src_scale = numerator / denominator;
   *tgt_from_src_translation =
       tgt_mean - *tgt_from_src_scale * tgt_from_src_rotation * src_mean;
+  return true;
+}
+
+namespace {
+
+double Median(std::vector<double> values) {
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  const double upper = values[mid];
+  if (values.size() % 2 == 1) {
+    return upper;
+  }
+  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + mid));
+}
+
+}  // namespace
+
+bool AlignViaSharedRigFrames(const std::vector<SharedRigFrame>& frames,
+                             const int min_points,
+                             const double fallback_scale,
+                             SharedFrameAlignment* alignment) {
+  if (frames.empty()) {
+    return false;
+  }
+  std::vector<double> log_ratios;
+  std::vector<Eigen::Matrix3d> rotations;
+  for (const SharedRigFrame& frame : frames) {
+    rotations.push_back(frame.tgt_rotation.transpose() * frame.src_rotation);
+    for (const auto& [src_point, tgt_point] : frame.src_tgt_points) {
+      const double src_distance =
+          (frame.src_rotation * src_point + frame.src_translation).norm();
+      const double tgt_distance =
+          (frame.tgt_rotation * tgt_point + frame.tgt_translation).norm();
+      // A point at the frame's origin (to rounding) carries no scale.
+      const double src_tiny = 1e-12 * (1 + frame.src_translation.norm());
+      const double tgt_tiny = 1e-12 * (1 + frame.tgt_translation.norm());
+      if (src_distance > src_tiny && tgt_distance > tgt_tiny &&
+          std::isfinite(src_distance) && std::isfinite(tgt_distance)) {
+        log_ratios.push_back(std::log(tgt_distance / src_distance));
+      }
+    }
+  }
+  if (log_ratios.empty() || static_cast<int>(log_ratios.size()) < min_points) {
+    if (!(fallback_scale > 0) || !std::isfinite(fallback_scale)) {
+      return false;
+    }
+    alignment->scale = fallback_scale;
+    alignment->num_points = 0;
+    alignment->log_scale_spread = 0;
+  } else {
+    const double log_scale = Median(log_ratios);
+    std::vector<double> deviations;
+    for (const double log_ratio : log_ratios) {
+      deviations.push_back(std::abs(log_ratio - log_scale));
+    }
+    alignment->scale = std::exp(log_scale);
+    alignment->num_points = static_cast<int>(log_ratios.size());
+    alignment->log_scale_spread = Median(deviations);
+  }
+  alignment->rotation = GeodesicMedianRotation(rotations);
+  // A frame's centre c = -R^T t in each model: c_tgt = s R c_src + t.
+  Eigen::Vector3d translation_sum = Eigen::Vector3d::Zero();
+  for (const SharedRigFrame& frame : frames) {
+    const Eigen::Vector3d src_center =
+        -frame.src_rotation.transpose() * frame.src_translation;
+    const Eigen::Vector3d tgt_center =
+        -frame.tgt_rotation.transpose() * frame.tgt_translation;
+    translation_sum +=
+        tgt_center - alignment->scale * alignment->rotation * src_center;
+  }
+  alignment->translation = translation_sum / frames.size();
   return true;
 }
 

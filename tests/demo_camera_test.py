@@ -11,7 +11,7 @@ import re
 
 from cli_util import TempDirTestCase, main_with_render
 from demo_test import MAX_LINES, run_demo
-from sphera_common import REPO_ROOT, run_render
+from sphera_common import REPO_ROOT, model_counts, run_colmap, run_render
 
 FUSION_3K = os.path.abspath(os.path.join(
     REPO_ROOT, "..", "shared", "data", "real_cameras", "gopro_fusion_3k"))
@@ -85,6 +85,27 @@ class DemoCameraTest(TempDirTestCase):
         # mostly rotating frames), as the preset run in docs/rigs.md.
         self.assertGreaterEqual(count, 6, output)
         self.assertIsNotNone(back_lens_turn(output), output)
+
+        # With the preset's intrinsics held the mapper ends in two models
+        # that share the middle frame (both lenses: two common images, too
+        # few for upstream's merge); SPHERA merges them through it.
+        models = {}
+        for merge in ("1", "0"):
+            sparse = self.path(f"sparse_merge{merge}")
+            os.makedirs(sparse)
+            run_colmap(
+                "mapper", "--database_path",
+                self.path("demo", "database.db"), "--image_path",
+                self.path("demo", "split", "images"), "--output_path", sparse,
+                "--Mapper.random_seed", "0",
+                "--Mapper.ba_refine_focal_length", "0",
+                "--Mapper.ba_refine_extra_params", "0",
+                "--Mapper.merge_rig_models", merge)
+            models[merge] = sorted(
+                model_counts(os.path.join(sparse, name))[0]
+                for name in os.listdir(sparse))
+        self.assertEqual(models["0"], [6, 6], models)
+        self.assertEqual(models["1"], [10], models)
 
 
 if __name__ == "__main__":
