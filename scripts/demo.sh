@@ -25,6 +25,10 @@
 #                                        preset's rig config; matching, the
 #                                        lens directions checked against the
 #                                        images (colmap rig_check), mapping
+#                                        (when the images split, once more
+#                                        with the lenses' intrinsics held,
+#                                        into sparse_held/, kept if its
+#                                        largest model holds more images)
 #                                        and the rig's calibration
 #
 # It prints one line per stage with its counts (images extracted, pairs
@@ -275,41 +279,80 @@ if [ -n "${rig_config}" ]; then
     "pairs inside frames (${stage_seconds} s)"
 fi
 
-mkdir -p "${WORK_DIR}/sparse"
-run_stage "mapping" \
-  's/.*Registering image #[0-9]* (num_reg_frames=\([0-9]*\)).*/\1 images registered/p' \
-  "${COLMAP}" mapper --database_path "${database}" --image_path "${image_dir}" \
-  --output_path "${WORK_DIR}/sparse" --Mapper.random_seed "${SEED}"
-models=0
-registered=""
-largest=0
-largest_points=0
-best_model=""
-for model in "${WORK_DIR}"/sparse/*/; do
-  [ -d "${model}" ] || continue
-  models=$(( models + 1 ))
-  statistics="$("${COLMAP}" model_analyzer --path "${model}" 2>&1)"
-  count="$(sed -n 's/.*Registered images: \([0-9]*\).*/\1/p' \
-    <<<"${statistics}")"
-  points="$(sed -n 's/.*Points: \([0-9]*\).*/\1/p' <<<"${statistics}")"
-  registered="${registered:+${registered} + }${count}"
-  # The largest model: most images, then most points.
-  if [ "${count:-0}" -gt "${largest}" ] || { [ "${count:-0}" -eq "${largest}" ] \
-      && [ "${points:-0}" -gt "${largest_points}" ]; }; then
-    largest="${count:-0}"
-    largest_points="${points:-0}"
-    best_model="${model%/}"
+# map_into DIR [OPTION ...]: the mapper's models in DIR/0, DIR/1, ...
+map_into() {
+  local dir="$1"
+  shift
+  rm -rf "${dir}"
+  mkdir -p "${dir}"
+  run_stage "mapping" \
+    's/.*Registering image #[0-9]* (num_reg_frames=\([0-9]*\)).*/\1 images registered/p' \
+    "${COLMAP}" mapper --database_path "${database}" \
+    --image_path "${image_dir}" --output_path "${dir}" \
+    --Mapper.random_seed "${SEED}" "$@"
+}
+
+# scan_models DIR: how many models, the images of each, the largest model
+# (most images, then most points) and its counts.
+scan_models() {
+  local model statistics count points
+  models=0
+  registered=""
+  largest=0
+  largest_points=0
+  best_model=""
+  for model in "$1"/*/; do
+    [ -d "${model}" ] || continue
+    models=$(( models + 1 ))
+    statistics="$("${COLMAP}" model_analyzer --path "${model}" 2>&1)"
+    count="$(sed -n 's/.*Registered images: \([0-9]*\).*/\1/p' \
+      <<<"${statistics}")"
+    points="$(sed -n 's/.*Points: \([0-9]*\).*/\1/p' <<<"${statistics}")"
+    registered="${registered:+${registered} + }${count}"
+    if [ "${count:-0}" -gt "${largest}" ] || { [ "${count:-0}" -eq "${largest}" ] \
+        && [ "${points:-0}" -gt "${largest_points}" ]; }; then
+      largest="${count:-0}"
+      largest_points="${points:-0}"
+      best_model="${model%/}"
+    fi
+  done
+  # Models of one run may share images: the largest model's count, and
+  # each model's beside it when there are several.
+  if [ "${models}" -gt 1 ]; then
+    where="the largest of ${models} models (${registered})"
+  else
+    where="${models} model"
   fi
-done
-# Models of one run may share images: the largest model's count, and each
-# model's beside it when there are several.
-if [ "${models}" -gt 1 ]; then
-  where="the largest of ${models} models (${registered})"
-else
-  where="${models} model"
-fi
-echo "mapping:            ${largest} of $(sql 'SELECT COUNT(*) FROM images')" \
+}
+
+num_images="$(sql 'SELECT COUNT(*) FROM images')"
+sparse_dir="${WORK_DIR}/sparse"
+map_into "${sparse_dir}"
+scan_models "${sparse_dir}"
+echo "mapping:            ${largest} of ${num_images}" \
   "images registered in ${where} (${stage_seconds} s)"
+# A short rig capture can leave the lenses' self-calibration too little to
+# go on, and the run splits; mapped again with the lenses held at the
+# preset's (or the rig config's) intrinsics, the kept run is the one whose
+# largest model holds more images.
+if [ -n "${rig_config}" ] && [ "${largest}" -lt "${num_images}" ]; then
+  refined=("${models}" "${registered}" "${largest}" "${largest_points}" \
+    "${best_model}" "${where}")
+  map_into "${WORK_DIR}/sparse_held" --Mapper.ba_refine_focal_length 0 \
+    --Mapper.ba_refine_extra_params 0
+  scan_models "${WORK_DIR}/sparse_held"
+  held_line="${largest} of ${num_images} images registered in ${where}"
+  if [ "${largest}" -gt "${refined[2]}" ]; then
+    verdict="kept"
+    sparse_dir="${WORK_DIR}/sparse_held"
+  else
+    verdict="not kept"
+    models="${refined[0]}"; registered="${refined[1]}"; largest="${refined[2]}"
+    largest_points="${refined[3]}"; best_model="${refined[4]}"
+    where="${refined[5]}"
+  fi
+  echo "  intrinsics held:  ${held_line} (${verdict}; ${stage_seconds} s)"
+fi
 if [ -n "${rig_config}" ] && [ -n "${best_model}" ]; then
   mkdir -p "${WORK_DIR}/rig_calibration"
   run_stage "rig calibration" 's/^$//p' "${COLMAP}" rig_calibration \
@@ -335,7 +378,7 @@ if [ -d "${scene_dir}/sparse_gt" ] && [ -n "${best_model}" ]; then
     --input_path "${best_model}" --depth_path "${scene_dir}/depth" \
     --output_path "${WORK_DIR}/evaluation" 2>>"${LOG}" | tail -n 7
 fi
-for model in "${WORK_DIR}"/sparse/*/; do
+for model in "${sparse_dir}"/*/; do
   [ -d "${model}" ] || continue
   "${COLMAP}" model_analyzer --path "${model}" 2>&1 \
     | grep -E "Cameras|Registered images|Points|Mean reprojection error" \
