@@ -106,5 +106,18 @@ class DemoCameraTest(TempDirTestCase):
         self.assertEqual(sorted(model_counts(os.path.join(sparse, name))[0]
                                 for name in os.listdir(sparse)), [6, 6])
 
+        # The global mapper keeps the rig's lenses at the preset's
+        # intrinsics (refined, every track was filtered): all 10 images.
+        global_sparse = self.path("sparse_global")
+        os.makedirs(global_sparse)
+        run_colmap(
+            "global_mapper", "--database_path",
+            self.path("demo", "database.db"), "--image_path",
+            self.path("demo", "split", "images"), "--output_path",
+            global_sparse, "--GlobalMapper.random_seed", "0")
+        images, points = model_counts(os.path.join(global_sparse, "0"))
+        self.assertEqual(images, 10)
+        self.assertGreater(points, 100)
+
 if __name__ == "__main__":
     main_with_render()
