@@ -275,6 +275,8 @@ def run_one(args, name, seed, work):
     scene = os.path.join(work, "scene")
     render = ["--rig_sensors", sensors, "--frames", args.frames, "--seed",
               seed, "--supersample", args.supersample, "--realistic"]
+    for option in args.render_option:
+        render.extend(option.split("=", 1))
     if storage == "side_by_side":
         render.append("--raw")
     started = time.monotonic()
@@ -415,6 +417,10 @@ def main():
                         "NAME DIR MODEL; default: the preset's)")
     parser.add_argument("--half_field_deg", type=float, default=0,
                         help="the lenses' half field (0: the preset's)")
+    parser.add_argument("--render_option", action="append", default=[],
+                        metavar="OPTION=VALUE",
+                        help="a sphera_render option after --realistic, "
+                        "e.g. --render_option=--vignetting=0 (repeatable)")
     parser.add_argument("--output", default=os.path.join(REPO, "build",
                                                          "bench_presets"))
     args = parser.parse_args()
