@@ -10,12 +10,12 @@
 namespace colmap {
 namespace {
 
-// Frames of one rig of two cameras a few centimetres apart, every point
-// seen by every image.
-Reconstruction MakeRigScene() {
+// Frames of one rig of `num_cameras` cameras a few centimetres apart,
+// every point seen by every image.
+Reconstruction MakeRigScene(int num_cameras = 2) {
   SyntheticDatasetOptions options;
   options.num_rigs = 1;
-  options.num_cameras_per_rig = 2;
+  options.num_cameras_per_rig = num_cameras;
   options.num_frames_per_rig = 5;
   options.num_points3D = 150;
   options.sensor_from_rig_translation_stddev = 0.05;
@@ -105,6 +105,21 @@ TEST(RigModelMerge, RefusesModelsWithoutASharedRigFrame) {
   EXPECT_EQ(tgt.NumRegFrames(), 3);
 }
 
+TEST(RigModelMerge, ModelsOfASingleCameraAreLeftAsUpstreamLeavesThem) {
+  const Reconstruction truth = MakeRigScene(/*num_cameras=*/1);
+  ReconstructionManager manager;
+  *manager.Get(manager.Add()) = SubModel(truth, {0, 1, 2});
+  *manager.Get(manager.Add()) = SubModel(truth, {2, 3, 4});
+  EXPECT_TRUE(SharedRigFrames(*manager.Get(0), *manager.Get(1)).empty());
+  const std::filesystem::path output =
+      std::filesystem::path(testing::TempDir()) / "rig_model_merge_single";
+  IncrementalPipelineOptions options;
+  EXPECT_EQ(MergeModelsSharingRigFrames(options, {}, output, 2, manager), 0);
+  EXPECT_EQ(manager.Size(), 2);
+  EXPECT_EQ(manager.Get(0)->NumRegFrames(), 3);
+  EXPECT_FALSE(std::filesystem::exists(output));
+}
+
 TEST(RigModelMerge, WithoutCommonPointsTheRigOffsetsGiveTheScale) {
   const Reconstruction truth = MakeRigScene();
   Reconstruction src = SubModel(truth, {0, 1, 2});
@@ -135,25 +150,27 @@ TEST(RigModelMerge, WithoutCommonPointsTheRigOffsetsGiveTheScale) {
 }
 
 TEST(RigModelMerge, RefusesAMergeThatDoesNotHoldTogether) {
-  const Reconstruction truth = MakeRigScene();
+  Reconstruction truth = MakeRigScene();
+  SyntheticNoiseOptions noise;
+  noise.point2D_stddev = 0.5;
+  SynthesizeNoise(noise, &truth);
   Reconstruction tgt = SubModel(truth, {2, 3, 4});
-  Reconstruction src = SubModel(truth, {0, 1, 2});
-  // The shared frame's points in src are wrong but agree on the scale:
-  // every point of src mirrored through the shared frame's origin.
-  const frame_t shared = SortedFrameIds(truth)[2];
-  const Eigen::Vector3d origin =
-      Inverse(src.Frame(shared).RigFromWorld()).translation();
-  for (const point3D_t point3D_id : src.Point3DIds()) {
-    Eigen::Vector3d& xyz = src.Point3D(point3D_id).xyz;
-    xyz = 2 * origin - xyz;
-  }
+  const Reconstruction src = SubModel(truth, {0, 1, 2});
   const size_t num_points = tgt.NumPoints3D();
+  // A point filter far below the keypoints' noise: the merged model keeps
+  // almost none of the two models' observations.
   IncrementalPipelineOptions options;
+  options.mapper.filter_max_reproj_error = 0.01;
   std::string why;
   EXPECT_FALSE(MergeRigModels(options, {}, 5, src, tgt, &why));
   EXPECT_NE(why.find("does not hold together"), std::string::npos) << why;
   EXPECT_EQ(tgt.NumRegFrames(), 3);
   EXPECT_EQ(tgt.NumPoints3D(), num_points);
+
+  // The same models merge under the mapper's filter.
+  options = IncrementalPipelineOptions();
+  EXPECT_TRUE(MergeRigModels(options, {}, 5, src, tgt, &why)) << why;
+  EXPECT_EQ(tgt.NumRegFrames(), 5);
 }
 
 TEST(RigModelMerge, RewritesTheOutputFoldersAfterAMerge) {
