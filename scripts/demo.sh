@@ -336,20 +336,17 @@ echo "mapping:            ${largest} of ${num_images}" \
 # preset's (or the rig config's) intrinsics, the kept run is the one whose
 # largest model holds more images.
 if [ -n "${rig_config}" ] && [ "${largest}" -lt "${num_images}" ]; then
-  refined=("${models}" "${registered}" "${largest}" "${largest_points}" \
-    "${best_model}" "${where}")
+  refined_largest="${largest}"
   map_into "${WORK_DIR}/sparse_held" --Mapper.ba_refine_focal_length 0 \
     --Mapper.ba_refine_extra_params 0
   scan_models "${WORK_DIR}/sparse_held"
   held_line="${largest} of ${num_images} images registered in ${where}"
-  if [ "${largest}" -gt "${refined[2]}" ]; then
+  if [ "${largest}" -gt "${refined_largest}" ]; then
     verdict="kept"
     sparse_dir="${WORK_DIR}/sparse_held"
   else
     verdict="not kept"
-    models="${refined[0]}"; registered="${refined[1]}"; largest="${refined[2]}"
-    largest_points="${refined[3]}"; best_model="${refined[4]}"
-    where="${refined[5]}"
+    scan_models "${sparse_dir}"
   fi
   echo "  intrinsics held:  ${held_line} (${verdict}; ${stage_seconds} s)"
 fi

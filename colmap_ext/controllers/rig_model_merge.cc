@@ -1,17 +1,18 @@
 #include "colmap_ext/controllers/rig_model_merge.h"
 
 #include "colmap/estimators/alignment.h"
-#include "colmap/estimators/bundle_adjustment.h"
 #include "colmap/sfm/observation_manager.h"
 #include "colmap/util/file.h"
 #include "colmap/util/logging.h"
 #include "colmap/util/misc.h"
+#include "colmap_ext/sfm/held_bundle_adjustment.h"
 
 #include "estimators/similarity_alignment.h"
 
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <unordered_set>
 #include <utility>
 
 namespace colmap {
@@ -31,15 +32,6 @@ constexpr double kReprojectionErrorSlackPx = 0.1;
 // that the scale needs: their median ratio survives two badly triangulated
 // ones.
 constexpr int kMinCommonPoints = 5;
-
-size_t NumFrameImages(const Frame& frame) {
-  size_t num_images = 0;
-  for (const data_t& data_id : frame.ImageIds()) {
-    (void)data_id;
-    ++num_images;
-  }
-  return num_images;
-}
 
 sphera::SharedRigFrame CollectSharedFrame(const Reconstruction& src,
                                           const Reconstruction& tgt,
@@ -100,19 +92,11 @@ void RefineMergedModel(const IncrementalPipelineOptions& options,
                        const std::vector<HeldCamera>& held_cameras,
                        Reconstruction& reconstruction) {
   ObservationManager(reconstruction).FilterObservationsWithNegativeDepth();
-  BundleAdjustmentConfig config;
-  for (const image_t image_id : reconstruction.RegImageIds()) {
-    config.AddImage(image_id);
-  }
+  std::unordered_set<camera_t> held_ids;
   for (const HeldCamera& held : held_cameras) {
-    if (reconstruction.ExistsCamera(held.camera.camera_id)) {
-      config.SetConstantCamIntrinsics(held.camera.camera_id);
-    }
+    held_ids.insert(held.camera.camera_id);
   }
-  config.FixGauge(BundleAdjustmentGauge::TWO_CAMS_FROM_WORLD);
-  CreateDefaultBundleAdjuster(
-      options.GlobalBundleAdjustment(), config, reconstruction)
-      ->Solve();
+  AdjustPosedImages(options.GlobalBundleAdjustment(), held_ids, reconstruction);
   ObservationManager(reconstruction)
       .FilterAllPoints3D(options.mapper.filter_max_reproj_error,
                          options.mapper.filter_min_tri_angle);
@@ -165,7 +149,8 @@ std::vector<frame_t> SharedRigFrames(const Reconstruction& reconstruction1,
         !reconstruction2.Frame(frame_id).HasPose()) {
       continue;
     }
-    if (NumFrameImages(reconstruction1.Frame(frame_id)) >= 2) {
+    const Frame& frame = reconstruction1.Frame(frame_id);
+    if (reconstruction1.Rig(frame.RigId()).NumSensors() >= 2) {
       shared.push_back(frame_id);
     }
   }
@@ -181,7 +166,7 @@ bool MergeRigModels(const IncrementalPipelineOptions& options,
                     std::string* why) {
   const std::vector<frame_t> frame_ids = SharedRigFrames(src, tgt);
   if (frame_ids.empty()) {
-    *why = "they share no frame of a rig with several cameras";
+    *why = "they share no frame of a rig with several sensors";
     return false;
   }
   std::vector<sphera::SharedRigFrame> frames;

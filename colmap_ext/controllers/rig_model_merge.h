@@ -19,7 +19,8 @@
 
 namespace colmap {
 
-// Frames registered in both models whose rig has more than one camera.
+// Frames registered in both models whose rig has several sensors (the
+// lenses of a multi-camera rig; DivergedCameraHold's criterion too).
 std::vector<frame_t> SharedRigFrames(const Reconstruction& reconstruction1,
                                      const Reconstruction& reconstruction2);
 

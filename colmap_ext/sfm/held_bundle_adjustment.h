@@ -14,10 +14,18 @@
 #include "colmap/scene/reconstruction.h"
 #include "colmap_ext/scene/intrinsics_divergence.h"
 
+#include <unordered_set>
+
 namespace colmap {
 
 // Bundle adjustment of every posed image of `reconstruction` (gauge: two
-// cameras), as the global mapper's: the cameras `hold` holds, and with
+// cameras), the intrinsics of `constant_intrinsics` held. True when the
+// solution is usable.
+bool AdjustPosedImages(const BundleAdjustmentOptions& options,
+                       const std::unordered_set<camera_t>& constant_intrinsics,
+                       Reconstruction& reconstruction);
+
+// AdjustPosedImages as the global mapper's: the cameras `hold` holds, and with
 // `hold_rig_lenses` each camera of a rig of several sensors, keep their
 // intrinsics; afterwards a camera that diverged from its prior in
 // `database_cache` is set back and held. True when the solution is usable.
