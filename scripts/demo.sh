@@ -210,33 +210,9 @@ print(json.load(open(sys.argv[1]))[0]["cameras"][0]["camera_model_name"])' \
       else
         inputs=(--input_path "${image_dir}")
       fi
-      # The generic preset's circles are a guess: the splitter finds the
-      # circles in the frames instead, and the lenses start from the
-      # preset's camera for the frames' size.
+      # The generic preset finds the circles in the frames; each lens starts
+      # from the preset's lens on its own circle.
       preset_args=(--camera "${camera}" ${model_args[@]+"${model_args[@]}"})
-      if [ "${camera}" = dual_fisheye ]; then
-        first_frame="$(find "${image_dir}" -maxdepth 1 -type f | sort | head -n 1)"
-        frame_size="$(python3 -c 'import struct, sys
-data = open(sys.argv[1], "rb").read(1 << 20)
-if data[:8] == b"\x89PNG\r\n\x1a\n":
-    w, h = struct.unpack(">II", data[16:24])
-else:
-    i = 2
-    while i < len(data) and not (data[i] == 0xFF and 0xC0 <= data[i + 1] <= 0xCF
-                                 and data[i + 1] not in (0xC4, 0xC8, 0xCC)):
-        i += 2 + struct.unpack(">H", data[i + 2:i + 4])[0]
-    h, w = struct.unpack(">HH", data[i + 5:i + 9])
-print(f"{w}x{h}")' "${first_frame}")"
-        run_stage "camera preset" 's/^$//p' "${COLMAP}" rig_preset \
-          --camera "${camera}" --resolution "${frame_size}" \
-          ${model_args[@]+"${model_args[@]}"} \
-          --output_path "${WORK_DIR}/preset_rig_config.json"
-        preset_args=($(python3 -c 'import json, sys
-c = json.load(open(sys.argv[1]))[0]["cameras"][0]
-print("--camera_model", c["camera_model_name"], "--camera_params",
-      ",".join("%.17g" % v for v in c["camera_params"]))' \
-          "${WORK_DIR}/preset_rig_config.json"))
-      fi
       run_stage "splitting" 's/.*\[\([0-9]*\/[0-9]*\)\].*/\1 frames/p' \
         "${COLMAP}" dual_fisheye_splitter ${preset_args[@]+"${preset_args[@]}"} \
         "${inputs[@]}" --output_path "${WORK_DIR}/split"

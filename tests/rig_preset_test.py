@@ -155,39 +155,44 @@ class RigPresetTest(TempDirTestCase):
 
     def test_side_by_side_frames_with_the_generic_preset(self):
         """Side-by-side frames split with --camera dual_fisheye: the
-        circles inscribed in the halves, the preset's rig config beside the
-        images; a frame of a size the preset refuses is named."""
-        size = 96
-        circle = (size / 2, size / 2, size / 2)
+        circles found in the frames (each lens its own, off the halves'
+        centres), each lens starting from the preset's 190° lens on its
+        circle, the preset's rig config beside the images."""
+        width, height = 96, 88
+        circles = [(47.3, 43.6, 40.2), (49.0, 44.25, 42.5)]
         for i in range(2):
             save(self.path("raw", f"f{i}.png"),
-                 make_raw(i, circles=[circle, circle], width=size,
-                          height=size))
+                 make_raw(i, circles=circles, width=width, height=height))
         output = self.path("split")
         run_colmap("dual_fisheye_splitter", "--input_path", self.path("raw"),
                    "--output_path", output, "--camera", "dual_fisheye")
         with open(os.path.join(output, "circles.txt")) as f:
             rows = [line.split() for line in f if not line.startswith("#")]
-        self.assertEqual([(row[0], tuple(float(v) for v in row[1:]))
-                          for row in rows],
-                         [("lens0", circle), ("lens1", circle)])
-        for lens in ("lens0", "lens1"):
+        self.assertEqual([row[0] for row in rows], ["lens0", "lens1"])
+        detected = [tuple(float(v) for v in row[1:]) for row in rows]
+        for got, true in zip(detected, circles):
+            np.testing.assert_allclose(got, true, atol=1.0)
+        for lens, circle in zip(("lens0", "lens1"), detected):
             for i in range(2):
                 mask = load(os.path.join(output, "masks", lens,
                                          f"f{i}.png.png"))
                 np.testing.assert_array_equal(
-                    mask, np.where(inside_mask(size, size, circle), 255, 0))
+                    mask, np.where(inside_mask(width, height, circle), 255, 0))
         with open(os.path.join(output, "rig_config.json")) as f:
             cameras = json.load(f)[0]["cameras"]
         self.assertEqual([c["image_prefix"] for c in cameras],
                          ["lens0/", "lens1/"])
         self.assertEqual(cameras[1]["cam_from_rig_rotation"], [0, 0, 1, 0])
-        for camera in cameras:
+        focal = []
+        for camera, circle in zip(cameras, detected):
             self.assertEqual(camera["camera_model_name"], "DOUBLE_SPHERE")
-            self.assertAlmostEqual(camera["camera_params"][2], circle[0],
-                                   delta=0.5)
-            self.assertAlmostEqual(camera["camera_params"][3], circle[1],
-                                   delta=0.5)
+            params = camera["camera_params"]
+            self.assertAlmostEqual(params[2], circle[0], delta=0.5)
+            self.assertAlmostEqual(params[3], circle[1], delta=0.5)
+            focal.append(params[0])
+        # The larger circle, the longer focal length (the same 190° lens).
+        self.assertAlmostEqual(focal[1] / focal[0],
+                               detected[1][2] / detected[0][2], delta=0.01)
 
         # --camera_model: the lenses start from that model, fitted to the
         # same lens (its principal point on the circle's centre); with
@@ -198,7 +203,7 @@ class RigPresetTest(TempDirTestCase):
                    "--camera_model", "OPENCV_FISHEYE")
         with open(os.path.join(output_kb, "rig_config.json")) as f:
             kb_cameras = json.load(f)[0]["cameras"]
-        for camera in kb_cameras:
+        for camera, circle in zip(kb_cameras, detected):
             self.assertEqual(camera["camera_model_name"], "OPENCV_FISHEYE")
             self.assertEqual(len(camera["camera_params"]), 8)
             self.assertAlmostEqual(camera["camera_params"][2], circle[0],
@@ -217,15 +222,15 @@ class RigPresetTest(TempDirTestCase):
             self.assertIn(needle, result.stdout, extra)
             self.assertFalse(os.path.exists(refused), extra)
 
-        save(self.path("odd", "odd.png"),
-             make_raw(5, circles=[circle, circle], width=size,
-                      height=size - 8))
+        # Frames without image circles are refused, naming them.
+        save(self.path("none", "plain.png"),
+             np.full((height, 2 * width, 3), 128, np.uint8))
         refused = self.path("refused")
         result = run_colmap("dual_fisheye_splitter", "--input_path",
-                            self.path("odd"), "--output_path", refused,
+                            self.path("none"), "--output_path", refused,
                             "--camera", "dual_fisheye", check=False)
         self.assertEqual(result.returncode, 1)
-        for needle in ("odd.png", f"{2 * size}x{size - 8}", "W = 2 H"):
+        for needle in ("plain.png", "no image circle"):
             self.assertIn(needle, result.stdout)
         self.assertFalse(os.path.exists(refused))
 

@@ -950,24 +950,23 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
 
   const std::vector<FrameFiles> frames = ListFrames(options);
   CheckOutputsAreNew(frames, lens_names, options.output_path);
-  std::string rig_config;
-  if (!options.camera.empty()) {
-    const sphera::CameraPreset& preset =
-        sphera::FindCameraPreset(options.camera);
-    const auto found = PresetCircles(preset, frames);
+  const sphera::CameraPreset* preset =
+      options.camera.empty() ? nullptr
+                             : &sphera::FindCameraPreset(options.camera);
+  // The generic preset knows no circles: they are found in the frames, and
+  // each lens starts from the preset's lens on its own circle.
+  const bool detect_preset_circles = preset && preset->any_two_to_one_size;
+  std::optional<sphera::PresetResolution> resolution;
+  if (preset && !detect_preset_circles) {
+    const auto found = PresetCircles(*preset, frames);
     if (!found) {
       ScanFrames(frames, lens_names, given_circles, options.black_level);
       throw std::invalid_argument("no frame can be read");
     }
-    const auto& [circles, resolution] = *found;
-    given_circles = circles;
-    rig_config = sphera::PresetRigConfigJson(
-        preset, resolution, {lens_names[0], lens_names[1]},
-        options.camera_model);
-    LOG(INFO) << "dual_fisheye_splitter: " << preset.name << " "
-              << resolution.name << ": circles " << resolution.source;
-  } else {
-    rig_config = RigConfigJson(lens_names, camera_json);
+    given_circles = found->first;
+    resolution = found->second;
+    LOG(INFO) << "dual_fisheye_splitter: " << preset->name << " "
+              << resolution->name << ": circles " << resolution->source;
   }
   const FrameScan scan =
       ScanFrames(frames, lens_names, given_circles, options.black_level);
@@ -1022,6 +1021,23 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
     }
   }
 
+  std::string rig_config;
+  if (preset) {
+    if (detect_preset_circles) {
+      resolution = sphera::PresetResolution{
+          "detected",
+          2 * scan.lens_size.width,
+          scan.lens_size.height,
+          {{circles[0].cx, circles[0].cy, circles[0].r},
+           {circles[1].cx, circles[1].cy, circles[1].r}},
+          "detected in the frames"};
+    }
+    rig_config = sphera::PresetRigConfigJson(
+        *preset, *resolution, {lens_names[0], lens_names[1]},
+        options.camera_model);
+  } else {
+    rig_config = RigConfigJson(lens_names, camera_json);
+  }
   WriteOutputs(
       options, frames, lens_names, circles, scan.lens_size, rig_config);
   size_t num_images = 0;
