@@ -155,4 +155,12 @@ std::vector<LensDirection> CheckRigDirections(
   return lenses;
 }
 
+Eigen::Vector2d LensAxisAzimuthElevationDeg(
+    const Eigen::Matrix3d& cam_from_ref) {
+  const Eigen::Vector3d axis = cam_from_ref.transpose().col(2);
+  const double deg_per_rad = 180 / M_PI;
+  return {std::atan2(axis.x(), axis.z()) * deg_per_rad,
+          std::atan2(-axis.y(), std::hypot(axis.x(), axis.z())) * deg_per_rad};
+}
+
 }  // namespace sphera

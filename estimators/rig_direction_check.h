@@ -72,4 +72,13 @@ std::vector<LensDirection> CheckRigDirections(
     const std::vector<LensPairRotation>& measurements,
     const RigDirectionCheckOptions& options);
 
+// The optical axis (z) of a lens turned CAM_FROM_REF from a reference lens,
+// in the reference lens's frame: x its azimuth about the reference's
+// vertical (image y) axis, from the reference's axis (0) towards its image
+// x (90; +-180 facing the other way); y its elevation towards the
+// reference's image up (-y). Degrees. A back lens turned 180 deg about a
+// slightly tilted axis is still turned 180 deg; its axis shows the tilt.
+Eigen::Vector2d LensAxisAzimuthElevationDeg(
+    const Eigen::Matrix3d& cam_from_ref);
+
 }  // namespace sphera

@@ -118,6 +118,32 @@ class SplitRenderedRawTest(TempDirTestCase):
                                            0.6 * mask.size)
 
 
+class LensAxesTest(TempDirTestCase):
+    """rig_calibration reports each lens's axis as the renderer placed it:
+    the 8-lens ring's lens k at azimuth k x 45° (towards the reference
+    lens's image x), elevation 0."""
+
+    def test_ring_lens_axes(self):
+        scene = self.path("ring")
+        run_render(scene, "--rig_preset", "ring8", "--frames", 1,
+                   "--lens_size", 64, "--supersample", 1)
+        out = self.path("calibration")
+        os.makedirs(out)
+        run_colmap("rig_calibration", "--input_path",
+                   os.path.join(scene, "sparse_gt"), "--output_path", out)
+        with open(os.path.join(out, "rig_calibration.json")) as f:
+            lenses = json.load(f)["rigs"][0]["lenses"]
+        self.assertEqual(len(lenses), 8)
+        for lens in lenses:
+            k = int(lens["name"][-1])
+            azimuth = (k * 45 + 180) % 360 - 180
+            self.assertAlmostEqual(
+                (lens["axis_azimuth_deg"] - azimuth + 180) % 360 - 180, 0,
+                delta=1e-6, msg=lens["name"])
+            self.assertAlmostEqual(lens["axis_elevation_deg"], 0, delta=1e-6,
+                                   msg=lens["name"])
+
+
 class SuffixFramesTest(TempDirTestCase):
     """Cameras that write NAME_1.JPG ... NAME_k.JPG (Vuze-style) form frames
     by the part before the suffix ("image_suffix" in the rig config)."""
@@ -358,6 +384,12 @@ class DualFisheyeRigTest(TempDirTestCase):
             self.assertGreater(lenses[name]["field_of_view_deg"], 185)
         self.assertAlmostEqual(lenses["lens1"]["rotation_from_reference_deg"],
                                180, delta=0.1)
+        # Its axis faces the other way: azimuth +-180, elevation 0.
+        self.assertAlmostEqual(abs(lenses["lens1"]["axis_azimuth_deg"]), 180,
+                               delta=0.1)
+        self.assertAlmostEqual(lenses["lens1"]["axis_elevation_deg"], 0,
+                               delta=0.1)
+        self.assertEqual(lenses["lens0"]["axis_azimuth_deg"], 0)
         fresh = self.path("fresh.db")
         shutil.copy(database, fresh)
         run_colmap("rig_configurator", "--database_path", fresh,

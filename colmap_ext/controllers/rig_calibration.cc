@@ -2,6 +2,7 @@
 
 #include "colmap_ext/controllers/model_evaluation.h"
 #include "colmap_ext/util/file_output.h"
+#include "estimators/rig_direction_check.h"
 
 #include <algorithm>
 #include <cmath>
@@ -209,6 +210,10 @@ RigCalibrationReport CalibrateRigs(const Reconstruction& model,
         lens.centre_in_rig = report.scale * (pose->rotation().inverse() *
                                              -pose->translation());
         lens.rotation_from_reference_deg = AngleDeg(pose->rotation());
+        const Eigen::Vector2d axis = sphera::LensAxisAzimuthElevationDeg(
+            pose->rotation().toRotationMatrix());
+        lens.axis_azimuth_deg = axis.x();
+        lens.axis_elevation_deg = axis.y();
       }
       if (ground_truth != nullptr) {
         if (const std::optional<camera_t> gt_camera_id = GroundTruthCamera(
@@ -268,7 +273,13 @@ std::string RigCalibrationText(const RigCalibrationReport& report) {
         const Eigen::Vector3d& centre = lens.centre_in_rig;
         table << "    pose in the rig: turned " << std::setprecision(3)
               << lens.rotation_from_reference_deg << " deg from "
-              << rig.lenses.front().name << ", centre ("
+              << rig.lenses.front().name;
+        if (!lens.reference) {
+          table << " (its axis at azimuth " << std::setprecision(2)
+                << lens.axis_azimuth_deg << " deg, elevation "
+                << lens.axis_elevation_deg << " deg)";
+        }
+        table << ", centre ("
               << std::setprecision(5) << centre.x() << ", " << centre.y()
               << ", " << centre.z() << "), " << centre.norm()
               << " from it\n";
@@ -316,7 +327,10 @@ std::string RigCalibrationJson(const RigCalibrationReport& report) {
            << "\", \"params\": " << JsonList(lens.camera.params)
            << ", \"field_of_view_deg\": " << lens.fov_deg
            << ", \"rotation_from_reference_deg\": "
-           << lens.rotation_from_reference_deg << ", \"centre_in_rig\": "
+           << lens.rotation_from_reference_deg
+           << ", \"axis_azimuth_deg\": " << lens.axis_azimuth_deg
+           << ", \"axis_elevation_deg\": " << lens.axis_elevation_deg
+           << ", \"centre_in_rig\": "
            << JsonList({centre.x(), centre.y(), centre.z()})
            << ", \"projection_median_px\": "
            << OptionalNumber(lens.projection_median_px)

@@ -7,7 +7,8 @@
 // the field of view (twice the largest angle from the optical axis of the
 // rays of the pixels inside the disc of radius_fraction x min(width,
 // height) around the principal point); per sensor: its pose relative to the
-// reference lens (rotation angle and the lens centre in the rig). With a
+// reference lens (rotation angle, the azimuth and elevation of its optical
+// axis, and the lens centre in the rig). With a
 // ground truth (a model of the same images, e.g. the renderer's sparse_gt
 // with rigs.txt): per lens the difference of the projections over that disc
 // (ground-truth pixel -> ray -> estimated pixel; median and max in pixels)
@@ -48,6 +49,14 @@ struct LensCalibration {
   // Rotation from the reference lens and the lens centre in the rig (in
   // the ground truth's units when there is one).
   double rotation_from_reference_deg = 0;
+  // The lens's optical axis in the reference lens's frame: its azimuth
+  // about the reference's vertical (image y) axis, from the reference's
+  // axis (0) towards its image x (90; +-180: facing the other way), and its
+  // elevation towards the reference's image up (-y). A back lens turned
+  // 180 deg about the vertical and tilted has a rotation angle near 180
+  // whatever its tilt; these two show the tilt.
+  double axis_azimuth_deg = 0;
+  double axis_elevation_deg = 0;
   Eigen::Vector3d centre_in_rig = Eigen::Vector3d::Zero();
   // With ground truth.
   std::optional<double> projection_median_px, projection_max_px, focal_ratio,

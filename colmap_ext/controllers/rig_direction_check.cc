@@ -336,7 +336,21 @@ std::string RigCheckText(const RigCheckReport& report) {
                  : std::string("direction not measured"))
          << ", " << direction.num_pairs << " lens pair(s), "
          << lens.num_frames << " frame(s), " << direction.num_inliers
-         << " inlier rays"
+         << " inlier rays";
+    // The measured axis in the measured reference lens's frame.
+    const LensCheck* reference = nullptr;
+    for (const LensCheck& other : report.lenses) {
+      if (other.rig_id == lens.rig_id && other.reference) reference = &other;
+    }
+    if (!lens.reference && direction.measured && reference != nullptr &&
+        reference->direction.measured) {
+      const Eigen::Vector2d axis = sphera::LensAxisAzimuthElevationDeg(
+          direction.measured_cam_from_rig *
+          reference->direction.measured_cam_from_rig.transpose());
+      text << "; measured axis at azimuth " << Format("%.2f", axis.x())
+           << " deg, elevation " << Format("%.2f", axis.y()) << " deg";
+    }
+    text
          << (direction.status == sphera::LensDirectionStatus::kContradicted
                  ? "  CONTRADICTED"
                  : "")

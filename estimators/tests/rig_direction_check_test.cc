@@ -168,5 +168,33 @@ TEST(RigDirectionCheck, LensWithoutPairsIsUnchecked) {
       std::invalid_argument);
 }
 
+TEST(RigDirectionCheck, LensAxisAzimuthAndElevation) {
+  const auto cam_from_ref = [](double yaw_deg, double up_deg) {
+    // The lens turned YAW about the reference's y axis (z towards x), then
+    // its axis raised UP towards -y.
+    const Eigen::Matrix3d ref_from_cam =
+        (Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(up_deg * M_PI / 180, Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
+    return Eigen::Matrix3d(ref_from_cam.transpose());
+  };
+  for (const double yaw : {0.0, 45.0, 90.0, 135.0, -45.0, -174.0, 179.5}) {
+    for (const double up : {0.0, 5.0, -30.0}) {
+      const Eigen::Vector2d axis =
+          LensAxisAzimuthElevationDeg(cam_from_ref(yaw, up));
+      EXPECT_NEAR(axis.x(), yaw, 1e-9) << yaw << " " << up;
+      EXPECT_NEAR(axis.y(), up, 1e-9) << yaw << " " << up;
+    }
+  }
+  // A back lens turned 180 deg about an axis tilted 3 deg from the
+  // vertical: its rotation is 180 deg, its axis 6 deg up or down.
+  const Eigen::Vector3d tilted(0, std::cos(3 * M_PI / 180),
+                               std::sin(3 * M_PI / 180));
+  const Eigen::Vector2d back = LensAxisAzimuthElevationDeg(
+      Eigen::AngleAxisd(M_PI, tilted).toRotationMatrix());
+  EXPECT_NEAR(std::abs(back.x()), 180, 1e-9);
+  EXPECT_NEAR(std::abs(back.y()), 6, 1e-9);
+}
+
 }  // namespace
 }  // namespace sphera
