@@ -7,6 +7,7 @@ set(SPHERA_COLMAP_CONTROLLER_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/controllers/dual_fisheye_splitting.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/image_errors.cc
   ${CMAKE_CURRENT_LIST_DIR}/image/dual_fisheye_split.cc
+  ${CMAKE_CURRENT_LIST_DIR}/image/flat_field.cc
   ${CMAKE_CURRENT_LIST_DIR}/image/image_file_structure.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/mapper_report.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/matching_status.cc

@@ -287,7 +287,8 @@ def run_one(args, name, seed, work):
     demo_dir = os.path.join(work, "demo")
     env = dict(os.environ, SPHERA_DEMO_DIR=demo_dir,
                SPHERA_COLMAP=args.colmap, SPHERA_RENDER=args.render,
-               SPHERA_DEMO_SEED=str(seed))
+               SPHERA_DEMO_SEED=str(seed),
+               SPHERA_DEMO_FLAT_FIELD="1" if args.flat_field else "0")
     demo = [os.path.join(REPO, "scripts", "demo.sh"), "--camera", preset,
             files]
     if args.camera_model:
@@ -421,6 +422,9 @@ def main():
                         metavar="OPTION=VALUE",
                         help="a sphera_render option after --realistic, "
                         "e.g. --render_option=--vignetting=0 (repeatable)")
+    parser.add_argument("--flat_field", action="store_true",
+                        help="the splitter divides out each lens's light "
+                        "fall-off (SPHERA_DEMO_FLAT_FIELD=1)")
     parser.add_argument("--output", default=os.path.join(REPO, "build",
                                                          "bench_presets"))
     args = parser.parse_args()

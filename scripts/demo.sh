@@ -37,7 +37,9 @@
 # COLMAP) goes to the log file it names, demo.log in the output folder.
 # RANSAC and the mapper draw from SPHERA_DEMO_SEED (default 0), so that a
 # run on the same images gives the same model; another seed is another
-# draw. Output goes to SPHERA_DEMO_DIR (default build/demo): database.db,
+# draw. SPHERA_DEMO_FLAT_FIELD=1 has the splitter divide out each lens's
+# light fall-off towards the rim (dual_fisheye_splitter --flat_field 1).
+# Output goes to SPHERA_DEMO_DIR (default build/demo): database.db,
 # sparse/, demo.log, and for the default scene the rendered images and the
 # ground truth.
 #
@@ -63,6 +65,7 @@ else
 fi
 readonly LOG="${WORK_DIR}/demo.log"
 readonly SEED="${SPHERA_DEMO_SEED:-0}"
+readonly FLAT_FIELD="${SPHERA_DEMO_FLAT_FIELD:-0}"
 
 camera=""
 lens_model=""
@@ -215,7 +218,8 @@ print(json.load(open(sys.argv[1]))[0]["cameras"][0]["camera_model_name"])' \
       preset_args=(--camera "${camera}" ${model_args[@]+"${model_args[@]}"})
       run_stage "splitting" 's/.*\[\([0-9]*\/[0-9]*\)\].*/\1 frames/p' \
         "${COLMAP}" dual_fisheye_splitter ${preset_args[@]+"${preset_args[@]}"} \
-        "${inputs[@]}" --output_path "${WORK_DIR}/split"
+        "${inputs[@]}" --flat_field "${FLAT_FIELD}" \
+        --output_path "${WORK_DIR}/split"
       image_dir="${WORK_DIR}/split/images"
       rig_config="${WORK_DIR}/split/rig_config.json"
       mask_args=(--ImageReader.mask_path "${WORK_DIR}/split/masks")

@@ -254,6 +254,55 @@ class DualFisheyeSplitterTest(TempDirTestCase):
         finally:
             db.close()
 
+    def test_flat_field_divides_out_the_light_fall_off(self):
+        """--flat_field 1: each lens's fall-off towards the rim (here the
+        renderer's vignetting, 1 - 0.7 rho^2 + 0.35 rho^4, the rim at 65%)
+        is estimated from its frames and divided out; without it the lens
+        images are the frames' pixels."""
+        raws, flats = [], []
+        for seed in range(12):
+            flat = make_raw(seed)
+            raw = flat.astype(np.float64)
+            for lens, (cx, cy, r) in enumerate(CIRCLES):
+                x = np.arange(LENS_W) + 0.5 - cx
+                y = np.arange(LENS_H) + 0.5 - cy
+                rho2 = np.minimum((x * x)[np.newaxis, :] +
+                                  (y * y)[:, np.newaxis], r * r) / (r * r)
+                gain = 1 - 0.7 * rho2 + 0.35 * rho2 * rho2
+                raw[:, lens * LENS_W:(lens + 1) * LENS_W] *= gain[..., None]
+            raw = np.round(raw).astype(np.uint8)
+            save(self.path("raw", f"f{seed}.png"), raw)
+            raws.append(raw)
+            flats.append(flat)
+        circles = ["--circles", circles_arg(CIRCLES)]
+        self.split(*circles, output=self.path("plain"))
+        for seed, raw in enumerate(raws):
+            self.assert_split(self.path("plain"), f"f{seed}.png", raw, CIRCLES)
+        result = self.split(*circles, "--flat_field", "1",
+                            output=self.path("flat"))
+        for lens in ("lens0", "lens1"):
+            self.assertRegex(result.stdout,
+                             lens + r": light fall-off from 12 images, the rim "
+                             r"at (6[0-9]|7[0-2])% of the centre")
+        for lens, circle in enumerate(CIRCLES):
+            inside = inside_mask(LENS_W, LENS_H, circle)
+            cx, cy, r = circle
+            x = np.arange(LENS_W) + 0.5 - cx
+            y = np.arange(LENS_H) + 0.5 - cy
+            rho = np.sqrt((x * x)[np.newaxis, :] + (y * y)[:, np.newaxis]) / r
+            ring = inside & (rho > 0.75) & (rho < 0.95)
+            for seed, flat in enumerate(flats):
+                image = load(self.path("flat", "images", f"lens{lens}",
+                                       f"f{seed}.png")).astype(np.float64)
+                truth = flat[:, lens * LENS_W:(lens + 1) * LENS_W]
+                darkened = raws[seed][:, lens * LENS_W:(lens + 1) * LENS_W]
+                # Near the rim the corrected images are the undarkened ones
+                # within a few per cent (the darkened ones 25-45% below).
+                ratio = image[ring].sum() / truth[ring].sum()
+                self.assertLess(abs(ratio - 1), 0.06, (lens, seed, ratio))
+                self.assertLess(darkened[ring].sum() / truth[ring].sum(), 0.8)
+                self.assertEqual(int(image[~inside].max()), 0)
+
     def test_bad_input(self):
         good = make_raw(30)
         save(self.path("raw", "good.png"), good)

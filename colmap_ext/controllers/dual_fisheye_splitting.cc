@@ -4,6 +4,7 @@
 #include "colmap/sensor/models.h"
 #include "colmap/util/logging.h"
 #include "colmap_ext/image/dual_fisheye_split.h"
+#include "colmap_ext/image/flat_field.h"
 #include "colmap_ext/scene/camera_params_error.h"
 #include "colmap_ext/util/file_output.h"
 #include "synthetic/file_formats.h"
@@ -748,10 +749,48 @@ std::string CirclesText(const std::array<std::string, 2>& lens_names,
 }
 
 // The last pass: every output file under a temporary name, then renamed.
+// Each lens's light fall-off from at most 60 of the frames (evenly spread),
+// logged per lens.
+std::array<RadialFalloff, 2> EstimateFalloffs(
+    const std::vector<FrameFiles>& frames,
+    const std::array<std::string, 2>& lens_names,
+    const std::array<ImageCircle, 2>& circles,
+    int black_level) {
+  std::array<RadialFalloffEstimator, 2> estimators = {
+      RadialFalloffEstimator(circles[0], black_level),
+      RadialFalloffEstimator(circles[1], black_level)};
+  const size_t step = std::max<size_t>(1, (frames.size() + 59) / 60);
+  for (size_t i = 0; i < frames.size(); i += step) {
+    const std::array<cv::Mat, 2> lenses = ReadLensImages(frames[i]);
+    for (int lens = 0; lens < 2; ++lens) {
+      if (!lenses[lens].empty()) estimators[lens].Add(lenses[lens]);
+    }
+  }
+  std::array<RadialFalloff, 2> falloffs;
+  for (int lens = 0; lens < 2; ++lens) {
+    std::string why;
+    falloffs[lens] = estimators[lens].Fit(3, 0.03, &why);
+    if (falloffs[lens].IsIdentity()) {
+      LOG(INFO) << "dual_fisheye_splitter: " << lens_names[lens]
+                << ": no light fall-off divided out (" << why << ")";
+    } else {
+      LOG(INFO) << "dual_fisheye_splitter: " << lens_names[lens]
+                << ": light fall-off from " << estimators[lens].NumImages()
+                << " images, the rim at "
+                << std::lround(100 * falloffs[lens].Gain(1))
+                << "% of the centre (1 + " << ShortestDoubleText(falloffs[lens].a)
+                << " rho^2 + " << ShortestDoubleText(falloffs[lens].b)
+                << " rho^4); divided out";
+    }
+  }
+  return falloffs;
+}
+
 void WriteOutputs(const DualFisheyeSplittingOptions& options,
                   const std::vector<FrameFiles>& frames,
                   const std::array<std::string, 2>& lens_names,
                   const std::array<ImageCircle, 2>& circles,
+                  const std::array<RadialFalloff, 2>& falloffs,
                   const cv::Size& lens_size,
                   const std::string& rig_config) {
   const fs::path& out = options.output_path;
@@ -772,7 +811,8 @@ void WriteOutputs(const DualFisheyeSplittingOptions& options,
       if (lenses[lens].empty()) {
         continue;
       }
-      const LensImage cut = CutImageCircle(lenses[lens], circles[lens]);
+      LensImage cut = CutImageCircle(lenses[lens], circles[lens]);
+      DivideByFalloff(circles[lens], falloffs[lens], &cut.image);
       staged.Write(out / "images" / lens_names[lens] / frame.name,
                    EncodeImage(cut.image,
                                extension,
@@ -1038,8 +1078,12 @@ void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
   } else {
     rig_config = RigConfigJson(lens_names, camera_json);
   }
-  WriteOutputs(
-      options, frames, lens_names, circles, scan.lens_size, rig_config);
+  const std::array<RadialFalloff, 2> falloffs =
+      options.flat_field ? EstimateFalloffs(frames, lens_names, circles,
+                                            options.black_level)
+                         : std::array<RadialFalloff, 2>();
+  WriteOutputs(options, frames, lens_names, circles, falloffs,
+               scan.lens_size, rig_config);
   size_t num_images = 0;
   for (const FrameFiles& frame : frames) {
     num_images += frame.SideBySide() ? 2

@@ -72,6 +72,9 @@ struct DualFisheyeSplittingOptions {
   std::string camera_model;
   std::string camera_params;
   int jpeg_quality = 95;
+  // Each lens's light fall-off towards the rim of its circle is estimated
+  // from its images and divided out (colmap_ext/image/flat_field.h).
+  bool flat_field = false;
   // A frame with the file of one lens missing (two folders, suffixes) is
   // an error, unless this: then its one lens is written, and
   // `rig_configurator --allow_incomplete_frames 1` takes it.

@@ -55,6 +55,10 @@ int RunDualFisheyeSplitter(int argc, char** argv) {
                            &splitting.camera_params,
                            "its parameters, comma-separated");
   options.AddDefaultOption("jpeg_quality", &splitting.jpeg_quality);
+  options.AddDefaultOption("flat_field", &splitting.flat_field,
+                           "estimate each lens's light fall-off towards the "
+                           "rim of its circle from its images and divide it "
+                           "out");
   options.AddDefaultOption("allow_incomplete_frames",
                            &splitting.allow_incomplete_frames,
                            "write the one lens of a frame whose other lens "
