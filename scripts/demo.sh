@@ -366,5 +366,12 @@ if [ -f "${WORK_DIR}/rig_calibration/rig_config.json" ]; then
   sed -n '/^=== rig calibration/,$p' "${LOG}" | awk '
     /^  [^ ].* \(camera [0-9]+,/ { lens = $1 }
     /pose in the rig:/ { sub(/.*pose in the rig: /, ""); print lens ": " $0 }'
+  # The lens axes the matches inside frames measured (colmap rig_check),
+  # before mapping: a second reading of the same lenses.
+  sed -n '/^=== rig check/,/^=== mapping/p' "${LOG}" | awk '
+    /measured axis at/ {
+      lens = $0; sub(/^[^(]*\(/, "", lens); sub(/\/?\).*/, "", lens)
+      axis = $0; sub(/.*measured axis at /, "", axis)
+      print lens ": matches inside frames put its axis at " axis }'
 fi
 echo "log: ${LOG}"

@@ -85,6 +85,13 @@ class DemoCameraTest(TempDirTestCase):
         # mostly rotating frames), as the preset run in docs/rigs.md.
         self.assertGreaterEqual(count, 6, output)
         self.assertIsNotNone(back_lens_turn(output), output)
+        # The matches inside the frames put the back lens's axis within 1°
+        # of 180° about the vertical (colmap rig_check, before mapping).
+        match = re.search(r"^lens1: matches inside frames put its axis at "
+                          r"azimuth (-?[0-9.]+) deg, elevation (-?[0-9.]+) "
+                          r"deg$", output, re.MULTILINE)
+        self.assertIsNotNone(match, output)
+        self.assertGreater(abs(float(match.group(1))), 179, output)
 
         # Split, the demo maps again with the preset's intrinsics held: two
         # models that share the middle frame (both lenses: two common
