@@ -275,8 +275,7 @@ def run_one(args, name, seed, work):
     scene = os.path.join(work, "scene")
     render = ["--rig_sensors", sensors, "--frames", args.frames, "--seed",
               seed, "--supersample", args.supersample, "--realistic"]
-    for option in args.render_option:
-        render.extend(option.split("=", 1))
+    render += common.render_options(args)
     if storage == "side_by_side":
         render.append("--raw")
     started = time.monotonic()
@@ -418,10 +417,7 @@ def main():
                         "NAME DIR MODEL; default: the preset's)")
     parser.add_argument("--half_field_deg", type=float, default=0,
                         help="the lenses' half field (0: the preset's)")
-    parser.add_argument("--render_option", action="append", default=[],
-                        metavar="OPTION=VALUE",
-                        help="a sphera_render option after --realistic, "
-                        "e.g. --render_option=--vignetting=0 (repeatable)")
+    common.add_render_option_argument(parser)
     parser.add_argument("--flat_field", action="store_true",
                         help="the splitter divides out each lens's light "
                         "fall-off (SPHERA_DEMO_FLAT_FIELD=1)")

@@ -459,10 +459,7 @@ def main():
                              "polynomial, not a fitted model")
     parser.add_argument("--realistic", action="store_true",
                         help="sphera_render's sensor effects")
-    parser.add_argument("--render_option", action="append", default=[],
-                        metavar="OPTION=VALUE",
-                        help="a sphera_render option after --realistic, "
-                        "e.g. --render_option=--vignetting=0 (repeatable)")
+    common.add_render_option_argument(parser)
     parser.add_argument("--fit_model", default="",
                         help="the rig starts from this model's rough "
                              "parameters (EUCM, DOUBLE_SPHERE, UNIFIED_OMNI, "
@@ -531,8 +528,7 @@ def main():
                         render += ["--lens_size", args.lens_size]
                 if args.realistic:
                     render += ["--realistic"]
-                for option in args.render_option:
-                    render.extend(option.split("=", 1))
+                render += common.render_options(args)
                 if preset == "dual_fisheye":
                     render += ["--stitched", "--stitched_width",
                                args.stitched_width]

@@ -35,8 +35,9 @@
 # verified, images registered), a progress line while a stage runs on a
 # terminal, and a summary; the output of every command (setup, build,
 # COLMAP) goes to the log file it names, demo.log in the output folder.
-# RANSAC and the mapper draw from SPHERA_DEMO_SEED (default 0), so that a
-# run on the same images gives the same model; another seed is another
+# RANSAC and the mapper draw from SPHERA_DEMO_SEED (default 0), so that
+# runs on the same images draw the same samples (matching on several
+# threads can still differ by a verified match); another seed is another
 # draw. SPHERA_DEMO_FLAT_FIELD=1 has the splitter divide out each lens's
 # light fall-off towards the rim (dual_fisheye_splitter --flat_field 1).
 # Output goes to SPHERA_DEMO_DIR (default build/demo): database.db,

@@ -555,6 +555,21 @@ def _prune_scene_cache():
         total -= size
 
 
+def add_render_option_argument(parser):
+    """--render_option OPTION=VALUE (repeatable): a sphera_render option
+    after --realistic; render_options(args) gives them as arguments."""
+    parser.add_argument("--render_option", action="append", default=[],
+                        metavar="OPTION=VALUE",
+                        help="a sphera_render option after --realistic, "
+                        "e.g. --render_option=--vignetting=0 (repeatable)")
+
+
+def render_options(args):
+    """The sphera_render arguments of args.render_option."""
+    return [part for option in args.render_option
+            for part in option.split("=", 1)]
+
+
 def run_render(output, *args, program=None):
     """Runs `sphera_render --output OUTPUT ARGS` (PROGRAM, default
     SPHERA_RENDER) without its output, or copies the same scene from the

@@ -748,7 +748,6 @@ std::string CirclesText(const std::array<std::string, 2>& lens_names,
   return text;
 }
 
-// The last pass: every output file under a temporary name, then renamed.
 // Each lens's light fall-off from at most 60 of the frames (evenly spread),
 // logged per lens.
 std::array<RadialFalloff, 2> EstimateFalloffs(
@@ -786,6 +785,7 @@ std::array<RadialFalloff, 2> EstimateFalloffs(
   return falloffs;
 }
 
+// The last pass: every output file under a temporary name, then renamed.
 void WriteOutputs(const DualFisheyeSplittingOptions& options,
                   const std::vector<FrameFiles>& frames,
                   const std::array<std::string, 2>& lens_names,

@@ -1,5 +1,7 @@
 #include "colmap_ext/image/flat_field.h"
 
+#include "colmap/math/math.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -18,21 +20,6 @@ constexpr double kMaxFitRho = 0.97;
 
 double BinRho(int bin) {
   return (bin + 0.5) / RadialFalloffEstimator::kNumBins;
-}
-
-double Median(std::vector<double> values) {
-  values.erase(std::remove_if(values.begin(), values.end(),
-                              [](double v) { return std::isnan(v); }),
-               values.end());
-  if (values.empty()) return kNaN;
-  const size_t middle = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + middle, values.end());
-  double median = values[middle];
-  if (values.size() % 2 == 0) {
-    median = 0.5 * (median + *std::max_element(values.begin(),
-                                               values.begin() + middle));
-  }
-  return median;
 }
 
 }  // namespace
@@ -104,7 +91,7 @@ RadialFalloff RadialFalloffEstimator::Fit(int min_images,
     return RadialFalloff();
   };
   if (NumImages() < min_images) {
-    return identity(std::to_string(NumImages()) + " image(s) with a centre, " +
+    return identity(std::to_string(NumImages()) + " image(s) with enough pixels, " +
                     std::to_string(min_images) + " needed");
   }
   // Least squares of the median profile by c (1 + a rho^2 + b rho^4)
@@ -116,10 +103,10 @@ RadialFalloff RadialFalloffEstimator::Fit(int min_images,
     if (rho > kMaxFitRho) break;
     std::vector<double> values;
     for (const std::vector<double>& profile : profiles_) {
-      values.push_back(profile[bin]);
+      if (!std::isnan(profile[bin])) values.push_back(profile[bin]);
     }
+    if (values.empty()) continue;
     const double median = Median(values);
-    if (std::isnan(median)) continue;
     const double weight = std::sqrt(rho);
     rows.push_back(weight *
                    Eigen::Vector3d(1, rho * rho, std::pow(rho, 4)));
