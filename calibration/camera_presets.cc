@@ -270,13 +270,15 @@ std::vector<CameraPreset> MakePresets() {
       "nominal"));
 
   // Any camera of two circles side by side in square halves: inscribed
-  // circles, 190° lenses back to back at one centre (the mapper finds the
-  // offset).
+  // circles, 190° lenses back to back, 3 cm apart (the middle of the 2 to 4
+  // cm of the cameras above; the mapper refines it). Lenses at one centre
+  // make a hand-held, mostly turning capture a panorama whose frames cannot
+  // be triangulated from one another.
   CameraPreset generic = SideBySideDualFisheye(
       "dual_fisheye",
       "any dual-fisheye camera: two 190° circles inscribed in the halves of "
       "a 2:1 frame (give its size)",
-      0.0, kUpright, 190, {}, "nominal");
+      0.03, kUpright, 190, {}, "nominal: offset 3 cm");
   generic.any_two_to_one_size = true;
   presets.push_back(generic);
   return presets;
