@@ -44,6 +44,16 @@ class DemoCameraTest(TempDirTestCase):
                       output)
         self.assertIn("--- the rig (colmap rig_calibration) ---", output)
 
+    def fusion_3k_demo(self, camera):
+        """The demo's output on the shared GoPro Fusion 3K folders with
+        --camera CAMERA, after checking its stages; skips without them."""
+        if not os.path.isdir(FUSION_3K):
+            self.skipTest(f"{FUSION_3K} is absent (../shared/data)")
+        result = run_demo(self.path("demo"), "--camera", camera, FUSION_3K)
+        self.assertEqual(result.returncode, 0, result.stdout)
+        self.assert_rig_stages(result.stdout, 10, 5)
+        return result.stdout
+
     def test_raw_dual_fisheye_frames_become_a_rig_model(self):
         # Two back-to-back 200° lenses side by side in 640x320 frames.
         scene = self.path("scene")
@@ -70,13 +80,7 @@ class DemoCameraTest(TempDirTestCase):
         self.assertIn("gopro_fusion", result.stdout)
 
     def test_gopro_fusion_folders_become_a_rig_model(self):
-        if not os.path.isdir(FUSION_3K):
-            self.skipTest(f"{FUSION_3K} is absent (../shared/data)")
-        result = run_demo(self.path("demo"), "--camera", "gopro_fusion",
-                          FUSION_3K)
-        output = result.stdout
-        self.assertEqual(result.returncode, 0, output)
-        self.assert_rig_stages(output, 10, 5)
+        output = self.fusion_3k_demo("gopro_fusion")
         mapping = registered(output)
         self.assertIsNotNone(mapping, output)
         count, total, _ = mapping
@@ -131,13 +135,7 @@ class DemoCameraTest(TempDirTestCase):
         each lens's circle in the frames, and the lenses start 3 cm apart
         (at one centre the mostly turning frames 4 and 5 stay out: 6 of
         10 even with the intrinsics held)."""
-        if not os.path.isdir(FUSION_3K):
-            self.skipTest(f"{FUSION_3K} is absent (../shared/data)")
-        result = run_demo(self.path("demo"), "--camera", "dual_fisheye",
-                          FUSION_3K)
-        output = result.stdout
-        self.assertEqual(result.returncode, 0, output)
-        self.assert_rig_stages(output, 10, 5)
+        output = self.fusion_3k_demo("dual_fisheye")
         with open(self.path("demo", "demo.log")) as log:
             detected = re.findall(r"lens[01]: image circle \(cx, cy, r\) = "
                                   r"\(([0-9.]+), ([0-9.]+), ([0-9.]+)\) "
