@@ -365,6 +365,9 @@ done
 if [ -f "${WORK_DIR}/rig_calibration/rig_config.json" ]; then
   echo "--- the rig (colmap rig_calibration) ---"
   sed -n '/^=== rig calibration/,$p' "${LOG}" | awk '
+    /^Rig [0-9]+: .*\(lengths in / {
+      units = $0; sub(/^[^(]*\(/, "", units); sub(/\)$/, "", units)
+      print units }
     /^  [^ ].* \(camera [0-9]+,/ { lens = $1 }
     /pose in the rig:/ { sub(/.*pose in the rig: /, ""); print lens ": " $0 }'
   # The lens axes the matches inside frames measured (colmap rig_check),

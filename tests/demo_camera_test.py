@@ -70,6 +70,10 @@ class DemoCameraTest(TempDirTestCase):
         turn = back_lens_turn(output)
         self.assertIsNotNone(turn, output)
         self.assertGreater(turn, 150, output)
+        # The lengths are the rig config's scale, and the summary says so.
+        self.assertIn("lengths in the model's units: the mapper scales a "
+                      "rig model so that its lens offsets are on average "
+                      "the rig config's", output)
 
     def test_unknown_camera_lists_the_known_ones(self):
         os.makedirs(self.path("frames"))

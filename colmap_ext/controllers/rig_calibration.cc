@@ -246,7 +246,9 @@ std::string RigCalibrationText(const RigCalibrationReport& report) {
           << " lenses, reference " << rig.lenses.front().name
           << (report.with_ground_truth
                   ? " (lengths in the ground truth's units)"
-                  : "")
+                  : " (lengths in the model's units: the mapper scales a rig "
+                    "model so that its lens offsets are on average the rig "
+                    "config's)")
           << "\n";
     for (const LensCalibration& lens : rig.lenses) {
       const Camera& camera = lens.camera;
