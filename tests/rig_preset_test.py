@@ -268,6 +268,129 @@ class RigPresetTest(TempDirTestCase):
         self.assertFalse(os.path.exists(self.path("no_such_folder")))
 
 
+VUZE_SIZE = (1080, 1920)  # width, height of one lens file
+VUZE_CIRCLE = (540, 960, 960)  # the preset's nominal circle, cropped
+
+
+def write_vuze_files(folder, frames, vignetting=0.0, seed=0):
+    """FRAMES captures of a Vuze-like camera, NAME_1.JPG ... NAME_8.JPG:
+    texture inside the circle darkened by 1 - VIGNETTING rho^2, a grey
+    housing (not black) outside."""
+    os.makedirs(folder, exist_ok=True)
+    rng = np.random.default_rng(seed)
+    width, height = VUZE_SIZE
+    inside = inside_mask(width, height, VUZE_CIRCLE)
+    x = np.arange(width) + 0.5 - VUZE_CIRCLE[0]
+    y = np.arange(height) + 0.5 - VUZE_CIRCLE[1]
+    rho2 = ((x * x)[np.newaxis, :] + (y * y)[:, np.newaxis]) / VUZE_CIRCLE[2] ** 2
+    gain = 1 - vignetting * rho2
+    for frame in range(frames):
+        for lens in range(1, 9):
+            coarse = rng.uniform(100, 220, size=(height // 16 + 1,
+                                                 width // 16 + 1))
+            texture = np.repeat(np.repeat(coarse, 16, axis=0), 16,
+                                axis=1)[:height, :width]
+            pixels = np.where(inside, texture * gain, 70).astype(np.uint8)
+            Image.fromarray(pixels).save(
+                os.path.join(folder, f"frame{frame:03d}_{lens}.JPG"),
+                quality=95)
+
+
+class VuzeFilesTest(TempDirTestCase):
+    """dual_fisheye_splitter --camera vuze: one file per lens in one folder,
+    each cut to the preset's circle with its mask, the preset's rig config;
+    a stray file, a missing lens file and a size the preset lacks are named,
+    nothing written."""
+
+    def split(self, source, output, *extra, check=True):
+        return run_colmap("dual_fisheye_splitter", "--camera", "vuze",
+                          "--input_path", source, "--output_path", output,
+                          *extra, check=check)
+
+    def test_lens_files_cut_masked_and_configured(self):
+        source = self.path("files")
+        write_vuze_files(source, 3, vignetting=0.5)
+        names = sorted(os.listdir(source))
+        output = self.path("out")
+        self.split(source, output)
+        self.assertEqual(sorted(os.listdir(self.path("out", "images"))),
+                         names)
+        width, height = VUZE_SIZE
+        inside = inside_mask(width, height, VUZE_CIRCLE)
+        for name in (names[0], names[-1]):
+            with Image.open(self.path("out", "masks", name + ".png")) as m:
+                np.testing.assert_array_equal(
+                    np.asarray(m), np.where(inside, 255, 0), err_msg=name)
+            with Image.open(self.path("out", "images", name)) as image:
+                pixels = np.asarray(image.convert("L")).astype(float)
+            # The grey housing is black now; the picture is kept.
+            self.assertLess(pixels[~inside].mean(), 2.0, name)
+            self.assertGreater(pixels[inside].mean(), 60.0, name)
+        with open(self.path("out", "rig_config.json")) as f:
+            cameras = json.load(f)[0]["cameras"]
+        self.assertEqual([c["image_suffix"] for c in cameras],
+                         [f"_{k}.JPG" for k in range(1, 9)])
+        with open(self.path("out", "circles.txt")) as f:
+            rows = [line.split() for line in f if not line.startswith("#")]
+        self.assertEqual([tuple(float(v) for v in row[1:]) for row in rows],
+                         [VUZE_CIRCLE] * 8)
+
+        # The fall-off divided out: near the rim as bright as the centre
+        # (the texture's mean is the same everywhere), without it 0.6x.
+        x = np.arange(width) + 0.5 - VUZE_CIRCLE[0]
+        y = np.arange(height) + 0.5 - VUZE_CIRCLE[1]
+        rho = np.sqrt((x * x)[np.newaxis, :] + (y * y)[:, np.newaxis]) / \
+            VUZE_CIRCLE[2]
+        centre, rim = rho < 0.3, (rho > 0.8) & (rho < 0.9)
+        self.split(source, self.path("flat"), "--flat_field", "1")
+
+        def rim_over_centre(folder):
+            ratios = []
+            for name in names:
+                with Image.open(os.path.join(folder, name)) as image:
+                    pixels = np.asarray(image.convert("L")).astype(float)
+                ratios.append(pixels[rim].mean() / pixels[centre].mean())
+            return float(np.median(ratios))
+
+        self.assertLess(rim_over_centre(self.path("out", "images")), 0.75)
+        self.assertAlmostEqual(rim_over_centre(self.path("flat", "images")),
+                               1.0, delta=0.06)
+
+    def test_bad_lens_files_are_named(self):
+        source = self.path("files")
+        write_vuze_files(source, 1)
+        cases = []
+        # A lens file missing.
+        missing = self.path("missing")
+        write_vuze_files(missing, 1)
+        os.remove(os.path.join(missing, "frame000_5.JPG"))
+        cases.append((missing, ["frame frame000", "frame000_5.JPG",
+                                "--allow_incomplete_frames"]))
+        # A file of no lens of the camera.
+        stray = self.path("stray")
+        write_vuze_files(stray, 1)
+        Image.new("L", VUZE_SIZE, 128).save(os.path.join(stray, "notes.JPG"))
+        cases.append((stray, ["notes.JPG", "_1.JPG", "_8.JPG"]))
+        # A size the preset does not know.
+        small = self.path("small")
+        os.makedirs(small)
+        for lens in range(1, 9):
+            Image.new("L", (540, 960), 128).save(
+                os.path.join(small, f"f_{lens}.JPG"))
+        cases.append((small, ["540x960", "1080x1920"]))
+        for folder, needles in cases:
+            output = self.path("out_" + os.path.basename(folder))
+            result = self.split(folder, output, check=False)
+            self.assertEqual(result.returncode, 1, result.stdout[-2000:])
+            for needle in needles:
+                self.assertIn(needle, result.stdout, folder)
+            self.assertFalse(os.path.exists(output), folder)
+        # The frame with a lens missing is written as it is when allowed.
+        output = self.path("incomplete_allowed")
+        self.split(missing, output, "--allow_incomplete_frames", "1")
+        self.assertEqual(len(os.listdir(os.path.join(output, "images"))), 7)
+
+
 @unittest.skipUnless(os.path.isdir(REAL),
                      f"needs {REAL} (the shared data set beside the "
                      "repository); not available here")
@@ -350,12 +473,19 @@ class RealGoProFusionPresetTest(TempDirTestCase):
         for needle in (name, "1536x1536", "3k (1568x1504)"):
             self.assertIn(needle, result.stdout)
         self.assertFalse(os.path.exists(output))
-        # A preset with no lens images to split is named.
+        # Nor is it a lens file of a camera of one file per lens.
         result = run_colmap("dual_fisheye_splitter", "--input_path",
                             self.path("stitched"), "--output_path", output,
                             "--camera", "vuze", check=False)
         self.assertEqual(result.returncode, 1)
-        self.assertIn("rig_preset --camera vuze", result.stdout)
+        self.assertIn(name + ": not a lens file of the vuze", result.stdout)
+        self.assertFalse(os.path.exists(output))
+        # A preset with no lens images to split is named.
+        result = run_colmap("dual_fisheye_splitter", "--input_path",
+                            self.path("stitched"), "--output_path", output,
+                            "--camera", "gopro_max", check=False)
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("rig_preset --camera gopro_max", result.stdout)
 
 
 if __name__ == "__main__":

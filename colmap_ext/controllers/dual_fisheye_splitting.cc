@@ -878,6 +878,192 @@ double LargestDeviation(const std::vector<ImageCircle>& circles,
   return largest;
 }
 
+// A preset that stores one file per lens (the Vuze's NAME_1.JPG ...
+// NAME_8.JPG in one folder): nothing to split. Every file is read and
+// checked first (a lens suffix of the preset, a size of the preset, every
+// lens of each frame unless allow_incomplete_frames, no existing output);
+// then each is cut to its lens's image circle (the preset's at that size),
+// with flat_field divided by its lens's fall-off, and written under its
+// own name beside its mask, with the preset's rig config.
+void WriteLensFiles(const DualFisheyeSplittingOptions& options,
+                    const sphera::CameraPreset& preset) {
+  const fs::path& out = options.output_path;
+  const std::vector<std::string> names =
+      options.image_list_path.empty()
+          ? ListImageFiles(options.input_path, out)
+          : ReadImageList(options.image_list_path, options.input_path);
+  if (names.empty()) {
+    throw std::invalid_argument("no lens files in " +
+                                options.input_path.string());
+  }
+  const int num_lenses = static_cast<int>(preset.lenses.size());
+  std::string suffixes;
+  for (const sphera::PresetLens& lens : preset.lenses) {
+    suffixes += (suffixes.empty() ? "" : ", ") + lens.file_suffix;
+  }
+  struct LensFile {
+    std::string name;
+    int lens = -1;
+  };
+  std::vector<LensFile> files;
+  std::map<std::string, std::set<int>> frames;  // frame name -> its lenses
+  std::vector<std::string> errors;
+  for (const std::string& name : names) {
+    LensFile file{name};
+    for (int lens = 0; lens < num_lenses && file.lens < 0; ++lens) {
+      const std::string& suffix = preset.lenses[lens].file_suffix;
+      if (name.size() > suffix.size() &&
+          name.compare(name.size() - suffix.size(), suffix.size(), suffix) ==
+              0) {
+        file.lens = lens;
+        frames[name.substr(0, name.size() - suffix.size())].insert(lens);
+      }
+    }
+    if (file.lens < 0) {
+      errors.push_back(name + ": not a lens file of the " + preset.name +
+                       " (its name ends in none of " + suffixes + ")");
+    }
+    files.push_back(file);
+  }
+  std::vector<std::string> incomplete;
+  for (const auto& [frame, lenses] : frames) {
+    for (int lens = 0; lens < num_lenses; ++lens) {
+      if (!lenses.count(lens)) {
+        incomplete.push_back("frame " + frame + ": no file " + frame +
+                             preset.lenses[lens].file_suffix + " of lens " +
+                             std::to_string(lens + 1));
+      }
+    }
+  }
+  if (options.allow_incomplete_frames) {
+    for (const std::string& message : incomplete) {
+      LOG(WARNING) << "dual_fisheye_splitter: " << message;
+    }
+  } else {
+    errors.insert(errors.end(), incomplete.begin(), incomplete.end());
+    if (!incomplete.empty()) {
+      errors.push_back("(--allow_incomplete_frames 1 writes the lenses a "
+                       "frame has)");
+    }
+  }
+  // Every file readable, a lens image, of one size the preset knows.
+  std::optional<cv::Size> size;
+  for (const LensFile& file : files) {
+    if (file.lens < 0) {
+      continue;
+    }
+    try {
+      const cv::Mat image = ReadImage(options.input_path / file.name);
+      if (const std::string error = LensImageError(image); !error.empty()) {
+        throw std::invalid_argument(error);
+      }
+      if (!size) {
+        size = image.size();
+      } else if (image.size() != *size) {
+        throw std::invalid_argument(SizeText(image.size()) + ", not the " +
+                                    SizeText(*size) + " of the first file");
+      }
+      if (!cv::haveImageWriter("x" + EncoderExtension(file.name))) {
+        throw std::invalid_argument("OpenCV cannot write its format (" +
+                                    LowerCaseExtension(file.name) + ")");
+      }
+    } catch (const std::exception& error) {
+      errors.push_back(file.name + ": " + error.what());
+    }
+  }
+  ThrowIfAny("files that are not lens files of the " + preset.name, errors);
+  const sphera::PresetResolution resolution =
+      sphera::FindPresetResolution(preset, size->width, size->height);
+  std::vector<ImageCircle> circles;
+  for (int lens = 0; lens < num_lenses; ++lens) {
+    const sphera::PresetCircle& circle = resolution.circles.at(lens);
+    circles.push_back({circle.cx, circle.cy, circle.r});
+  }
+  std::vector<std::string> existing;
+  for (const fs::path& path : {out / "rig_config.json", out / "circles.txt"}) {
+    if (fs::exists(path)) {
+      existing.push_back(path.string());
+    }
+  }
+  for (const LensFile& file : files) {
+    for (const fs::path& path :
+         {out / "images" / file.name, out / "masks" / (file.name + ".png")}) {
+      if (fs::exists(path)) {
+        existing.push_back(path.string());
+      }
+    }
+  }
+  ThrowIfAny(
+      "refusing to overwrite existing output files (choose another "
+      "--output_path or remove them)",
+      existing);
+
+  std::vector<RadialFalloff> falloffs(num_lenses);
+  if (options.flat_field) {
+    for (int lens = 0; lens < num_lenses; ++lens) {
+      std::vector<const LensFile*> of_lens;
+      for (const LensFile& file : files) {
+        if (file.lens == lens) of_lens.push_back(&file);
+      }
+      RadialFalloffEstimator estimator(circles[lens], options.black_level);
+      const size_t step = std::max<size_t>(1, (of_lens.size() + 59) / 60);
+      for (size_t i = 0; i < of_lens.size(); i += step) {
+        estimator.Add(ReadImage(options.input_path / of_lens[i]->name));
+      }
+      std::string why;
+      falloffs[lens] = estimator.Fit(3, 0.03, &why);
+      const std::string lens_name =
+          "lens " + std::to_string(lens + 1) + " (" +
+          preset.lenses[lens].file_suffix + ")";
+      if (falloffs[lens].IsIdentity()) {
+        LOG(INFO) << "dual_fisheye_splitter: " << lens_name
+                  << ": no light fall-off divided out (" << why << ")";
+      } else {
+        LOG(INFO) << "dual_fisheye_splitter: " << lens_name
+                  << ": light fall-off from " << estimator.NumImages()
+                  << " images, the rim at "
+                  << std::lround(100 * falloffs[lens].Gain(1))
+                  << "% of the centre; divided out";
+      }
+    }
+  }
+
+  StagedOutput staged;
+  std::vector<std::string> mask_bytes(num_lenses);
+  std::string circles_text = "# SENSOR CX CY R (pixels, image corner at 0, 0)\n";
+  for (int lens = 0; lens < num_lenses; ++lens) {
+    mask_bytes[lens] = EncodeImage(ImageCircleMask(*size, circles[lens]),
+                                   ".png", {},
+                                   "the mask of lens " + std::to_string(lens + 1));
+    circles_text += "lens" + std::to_string(lens + 1) + " " +
+                    ShortestDoubleText(circles[lens].cx) + " " +
+                    ShortestDoubleText(circles[lens].cy) + " " +
+                    ShortestDoubleText(circles[lens].r) + "\n";
+  }
+  for (const LensFile& file : files) {
+    const std::string extension = EncoderExtension(file.name);
+    LensImage cut = CutImageCircle(ReadImage(options.input_path / file.name),
+                                   circles[file.lens]);
+    DivideByFalloff(circles[file.lens], falloffs[file.lens], &cut.image);
+    staged.Write(out / "images" / file.name,
+                 EncodeImage(cut.image, extension,
+                             sphera::ImageWriteParams(extension,
+                                                      options.jpeg_quality),
+                             file.name));
+    staged.Write(out / "masks" / (file.name + ".png"), mask_bytes[file.lens]);
+  }
+  staged.Write(out / "rig_config.json",
+               sphera::PresetRigConfigJson(preset, resolution, {},
+                                           options.camera_model));
+  staged.Write(out / "circles.txt", circles_text);
+  staged.Commit();
+  LOG(INFO) << "dual_fisheye_splitter: " << preset.name << " "
+            << resolution.name << ": " << files.size() << " lens files of "
+            << frames.size() << " frames -> lens images and masks ("
+            << SizeText(*size) << ") in " << out.string()
+            << "/images; circles " << resolution.source;
+}
+
 }  // namespace
 
 void DualFisheyeSplittingOptions::Check() const {
@@ -946,9 +1132,17 @@ void DualFisheyeSplittingOptions::Check() const {
         !error.empty()) {
       throw std::invalid_argument(error);
     }
-    if (preset.storage == sphera::LensStorage::kFilePerLens ||
-        preset.storage == sphera::LensStorage::kEquirectangular ||
-        preset.lenses.size() != 2) {
+    if (preset.storage == sphera::LensStorage::kFilePerLens) {
+      if (input_path.empty() || !lens_suffixes.empty() ||
+          lens_names != "lens0,lens1") {
+        throw std::invalid_argument(
+            "--camera " + preset.name +
+            ": one file per lens in --input_path (named as the camera "
+            "names them); not with --front_path, --back_path, "
+            "--lens_suffixes or --lens_names");
+      }
+    } else if (preset.storage == sphera::LensStorage::kEquirectangular ||
+               preset.lenses.size() != 2) {
       throw std::invalid_argument(
           "--camera " + preset.name + ": " + std::to_string(
               preset.lenses.size()) + " lens(es), " +
@@ -975,6 +1169,14 @@ void DualFisheyeSplittingOptions::Check() const {
 
 void SplitDualFisheyeFrames(const DualFisheyeSplittingOptions& options) {
   options.Check();
+  if (!options.camera.empty()) {
+    const sphera::CameraPreset& preset =
+        sphera::FindCameraPreset(options.camera);
+    if (preset.storage == sphera::LensStorage::kFilePerLens) {
+      WriteLensFiles(options, preset);
+      return;
+    }
+  }
   const std::array<std::string, 2> lens_names =
       ParseLensNames(options.lens_names);
   const std::string camera_json =

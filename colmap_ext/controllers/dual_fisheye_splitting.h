@@ -19,6 +19,11 @@
 //   suffixes      input_path holds both lenses' files, NAME<s0>.EXT and
 //                 NAME<s1>.EXT with lens_suffixes "s0,s1" (IMG_7_0.jpg,
 //                 IMG_7_1.jpg); NAME.EXT is the frame's NAME (IMG_7.jpg).
+// A camera preset that stores one file per lens (`camera` vuze:
+// NAME_1.JPG ... NAME_8.JPG in input_path) has nothing to split: each file
+// is cut to its lens's circle (the preset's at the files' size) and written
+// as OUT/images/NAME_k.JPG with OUT/masks/NAME_k.JPG.png, beside the
+// preset's rig config (its lenses found by those suffixes) and circles.txt.
 // Outputs, in the layout of `colmap rig_configurator`:
 //   OUT/images/<lens>/NAME      the lens image, pixels copied exactly, those
 //                               outside the circle black; NAME's format

@@ -17,7 +17,8 @@ int RunDualFisheyeSplitter(int argc, char** argv) {
   options.AddDefaultOption("input_path",
                            &splitting.input_path,
                            "side-by-side raw frames, or with lens_suffixes "
-                           "one file per lens");
+                           "one file per lens (or with a --camera that "
+                           "stores one file per lens: its files)");
   options.AddDefaultOption(
       "front_path", &splitting.front_path, "the front lens's files (lens0)");
   options.AddDefaultOption(
