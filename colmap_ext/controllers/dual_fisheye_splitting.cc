@@ -972,8 +972,14 @@ void WriteLensFiles(const DualFisheyeSplittingOptions& options,
     }
   }
   ThrowIfAny("files that are not lens files of the " + preset.name, errors);
-  const sphera::PresetResolution resolution =
-      sphera::FindPresetResolution(preset, size->width, size->height);
+  sphera::PresetResolution resolution;
+  try {
+    resolution =
+        sphera::FindPresetResolution(preset, size->width, size->height);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(options.input_path.string() + ": lens files " +
+                                SizeText(*size) + ": " + error.what());
+  }
   std::vector<ImageCircle> circles;
   for (int lens = 0; lens < num_lenses; ++lens) {
     const sphera::PresetCircle& circle = resolution.circles.at(lens);
