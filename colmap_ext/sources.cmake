@@ -31,10 +31,12 @@ set(SPHERA_COLMAP_SCENE_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/scene/rig_config.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/unused_cameras.cc)
 # Sources of colmap_ext/sfm/ that the patch series compiles into COLMAP's
-# colmap_sfm library (the incremental mapper's initial pair of rig frames,
-# the global mapper's bundle adjustments with held lenses).
+# colmap_sfm library (the incremental mapper's initial pair search and its
+# pairs of rig frames, the global mapper's bundle adjustments with held
+# lenses).
 set(SPHERA_COLMAP_SFM_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/sfm/held_bundle_adjustment.cc
+  ${CMAKE_CURRENT_LIST_DIR}/sfm/initial_pair_search.cc
   ${CMAKE_CURRENT_LIST_DIR}/sfm/rig_initial_pair.cc)
 set(SPHERA_COLMAP_CONTROLLER_LIBS
   $<BUILD_INTERFACE:sphera_calibration>

@@ -137,8 +137,8 @@ class DemoCameraTest(TempDirTestCase):
     def test_gopro_fusion_folders_with_the_circles_detected(self):
         """The generic preset on the same folders: the splitter detects
         each lens's circle in the frames, the lenses start 3 cm apart, and
-        the frames map as a rig (6 of 10 images in most runs, all 10 in
-        some: which frames the first model takes decides it; docs/rigs.md)."""
+        the frames map as a rig (6 of 10 images: frames 4 and 5 alone
+        start no second model; docs/rigs.md)."""
         output = self.fusion_3k_demo("dual_fisheye")
         with open(self.path("demo", "demo.log")) as log:
             detected = re.findall(r"lens[01]: image circle \(cx, cy, r\) = "
