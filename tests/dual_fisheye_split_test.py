@@ -344,6 +344,15 @@ class DualFisheyeSplitterTest(TempDirTestCase):
             f.write(b"\x89PNG\r\n\x1a\nnot really")
         self.assert_refused(["broken.png", "cannot read"], *given)
         os.remove(self.path("raw", "broken.png"))
+        # A frame cut short (an interrupted copy), which OpenCV decodes
+        # with gray where its data is missing.
+        with open(self.path("raw", "good.png"), "rb") as f:
+            data = f.read()
+        with open(self.path("raw", "cut.png"), "wb") as f:
+            f.write(data[:len(data) // 2])
+        self.assert_refused(["cut.png", "truncated PNG: the file ends before"],
+                            *given)
+        os.remove(self.path("raw", "cut.png"))
 
         # Frames of two sizes.
         save(self.path("raw", "small.png"),

@@ -371,6 +371,14 @@ class VuzeFilesTest(TempDirTestCase):
         write_vuze_files(stray, 1)
         Image.new("L", VUZE_SIZE, 128).save(os.path.join(stray, "notes.JPG"))
         cases.append((stray, ["notes.JPG", "_1.JPG", "_8.JPG"]))
+        # A lens file cut short.
+        cut = self.path("cut")
+        write_vuze_files(cut, 1)
+        with open(os.path.join(cut, "frame000_3.JPG"), "rb") as f:
+            data = f.read()
+        with open(os.path.join(cut, "frame000_3.JPG"), "wb") as f:
+            f.write(data[:len(data) // 2])
+        cases.append((cut, ["frame000_3.JPG", "truncated JPEG"]))
         # A size the preset does not know.
         small = self.path("small")
         os.makedirs(small)

@@ -5,6 +5,7 @@
 #include "colmap/util/logging.h"
 #include "colmap_ext/image/dual_fisheye_split.h"
 #include "colmap_ext/image/flat_field.h"
+#include "colmap_ext/image/image_file_structure.h"
 #include "colmap_ext/scene/camera_params_error.h"
 #include "colmap_ext/util/file_output.h"
 #include "synthetic/file_formats.h"
@@ -16,6 +17,7 @@
 #include <cstdlib>
 #include <exception>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <set>
@@ -496,11 +498,28 @@ std::vector<FrameFiles> ListFrames(const DualFisheyeSplittingOptions& options) {
 }
 
 // PATH decoded as stored (bit depth, channels, no EXIF rotation); throws
-// naming the file when it cannot be.
+// naming the file when it cannot be. A JPEG or PNG cut short or overwritten,
+// which OpenCV decodes with gray where its data is missing, is refused
+// (ImageBytesError, as feature extraction does).
 cv::Mat ReadImage(const fs::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(stream)),
+                          std::istreambuf_iterator<char>());
+  if (!stream.good() && !stream.eof()) {
+    throw std::runtime_error("cannot read the image " + path.string());
+  }
+  if (bytes.empty()) {
+    throw std::runtime_error("the image " + path.string() + " is empty");
+  }
+  if (const std::string damage = ImageBytesError(bytes); !damage.empty()) {
+    throw std::runtime_error("cannot read the image " + path.string() +
+                             ": " + damage);
+  }
   cv::Mat image;
   try {
-    image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,
+                                 const_cast<char*>(bytes.data())),
+                         cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& error) {
     throw std::runtime_error("cannot read the image " + path.string() + ": " +
                              error.what());
@@ -971,7 +990,8 @@ void WriteLensFiles(const DualFisheyeSplittingOptions& options,
       errors.push_back(file.name + ": " + error.what());
     }
   }
-  ThrowIfAny("files that are not lens files of the " + preset.name, errors);
+  ThrowIfAny("files that are not usable lens files of the " + preset.name,
+             errors);
   sphera::PresetResolution resolution;
   try {
     resolution =
