@@ -19,9 +19,8 @@ Usage (from the repository root):
   scripts/keypoint_scale_bias.py --model SPARSE/0 --database DB.db \\
       [--output_dir DIR] [--label NAME]
 prints the table and writes DIR/scale_bias.csv and DIR/scale_bias.png
-(default DIR: the model's folder). The model may be binary or text; its
-cameras must be OPENCV_FISHEYE, DOUBLE_SPHERE, EUCM, PINHOLE or
-SIMPLE_PINHOLE."""
+(default DIR: the model's folder). The model may be binary or text, of any
+camera model but EQUIRECTANGULAR (the projections of scripts/cramer_rao.py)."""
 import argparse
 import csv
 import os
@@ -32,6 +31,7 @@ import tempfile
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cramer_rao  # noqa: E402
 import sphera_common as common  # noqa: E402
 
 RADIUS_BINS = [0, 150, 300, 400, 450, 500, 600, 800, 1200, 2000, 4000]
@@ -40,42 +40,20 @@ MIN_COUNT = 20
 
 
 def project(model, params, X):
-    """Pixels (N x 2) of camera-frame points X (N x 3); NaN where the model
-    does not project them."""
-    x, y, z = X[:, 0], X[:, 1], X[:, 2]
-    fx, fy, cx, cy = params[:4]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        if model == "OPENCV_FISHEYE":
-            k1, k2, k3, k4 = params[4:8]
-            r = np.hypot(x, y)
-            th = np.arctan2(r, z)
-            th2 = th * th
-            thd = th * (1 + th2 * (k1 + th2 * (k2 + th2 * (k3 + th2 * k4))))
-            # theta_d / r -> 1 / z on the axis.
-            factor = np.where(r > 0, thd / np.where(r > 0, r, 1), 1 / z)
-            mx, my = factor * x, factor * y
-        elif model == "DOUBLE_SPHERE":
-            xi, alpha = params[4:6]
-            d1 = np.sqrt(x * x + y * y + z * z)
-            zz = xi * d1 + z
-            d2 = np.sqrt(x * x + y * y + zz * zz)
-            den = alpha * d2 + (1 - alpha) * zz
-            mx, my = x / den, y / den
-        elif model == "EUCM":
-            alpha, beta = params[4:6]
-            d = np.sqrt(beta * (x * x + y * y) + z * z)
-            den = alpha * d + (1 - alpha) * z
-            mx, my = x / den, y / den
-        elif model in ("PINHOLE", "SIMPLE_PINHOLE"):
-            if model == "SIMPLE_PINHOLE":
-                fx, cx, cy = params[:3]
-                fy = fx
-            mx, my = x / z, y / z
-        else:
-            raise SystemExit(f"keypoint_scale_bias: camera model {model} is "
-                             "not supported (OPENCV_FISHEYE, DOUBLE_SPHERE, "
-                             "EUCM, PINHOLE, SIMPLE_PINHOLE)")
-        return np.stack([fx * mx + cx, fy * my + cy], axis=1), (cx, cy)
+    """Pixels (N x 2) of camera-frame points X (N x 3) through the camera
+    (cramer_rao.project, which follows camera_models/), and the principal
+    point: the pixel of the optical axis."""
+    if model == "EQUIRECTANGULAR":
+        raise SystemExit("keypoint_scale_bias: camera model EQUIRECTANGULAR "
+                         "has no principal point to measure radii from")
+    camera = (model, 0, 0, list(params))
+    try:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            uv = cramer_rao.project(camera, np.asarray(X, dtype=float))
+            centre = cramer_rao.project(camera, np.array([[0.0, 0.0, 1.0]]))
+    except ValueError as error:
+        raise SystemExit(f"keypoint_scale_bias: {error}") from None
+    return uv, (float(centre[0, 0]), float(centre[0, 1]))
 
 
 def keypoint_scales(database):
