@@ -3,9 +3,9 @@
 #include "calibration/camera_presets.h"
 #include "colmap/sensor/models.h"
 #include "colmap/util/logging.h"
+#include "colmap_ext/controllers/image_errors.h"
 #include "colmap_ext/image/dual_fisheye_split.h"
 #include "colmap_ext/image/flat_field.h"
-#include "colmap_ext/image/image_file_structure.h"
 #include "colmap_ext/scene/camera_params_error.h"
 #include "colmap_ext/util/file_output.h"
 #include "synthetic/file_formats.h"
@@ -17,7 +17,6 @@
 #include <cstdlib>
 #include <exception>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <optional>
 #include <set>
@@ -500,26 +499,15 @@ std::vector<FrameFiles> ListFrames(const DualFisheyeSplittingOptions& options) {
 // PATH decoded as stored (bit depth, channels, no EXIF rotation); throws
 // naming the file when it cannot be. A JPEG or PNG cut short or overwritten,
 // which OpenCV decodes with gray where its data is missing, is refused
-// (ImageBytesError, as feature extraction does).
+// (ImageFileError, as feature extraction does).
 cv::Mat ReadImage(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(stream)),
-                          std::istreambuf_iterator<char>());
-  if (!stream.good() && !stream.eof()) {
-    throw std::runtime_error("cannot read the image " + path.string());
-  }
-  if (bytes.empty()) {
-    throw std::runtime_error("the image " + path.string() + " is empty");
-  }
-  if (const std::string damage = ImageBytesError(bytes); !damage.empty()) {
-    throw std::runtime_error("cannot read the image " + path.string() +
-                             ": " + damage);
+  if (const std::string error = ImageFileError(path); !error.empty()) {
+    throw std::runtime_error("cannot read the image " + path.string() + ": " +
+                             error);
   }
   cv::Mat image;
   try {
-    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,
-                                 const_cast<char*>(bytes.data())),
-                         cv::IMREAD_UNCHANGED);
+    image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& error) {
     throw std::runtime_error("cannot read the image " + path.string() + ": " +
                              error.what());
@@ -756,15 +744,40 @@ void CheckFrames(const std::vector<FrameFiles>& frames,
 
 // The header of the renderer's circles.txt (synthetic/rig.h), so that one
 // reader takes both.
-std::string CirclesText(const std::array<std::string, 2>& lens_names,
-                        const std::array<ImageCircle, 2>& circles) {
+std::string CirclesText(const std::vector<std::string>& lens_names,
+                        const std::vector<ImageCircle>& circles) {
   std::string text = "# SENSOR CX CY R (pixels, image corner at 0, 0)\n";
-  for (int lens = 0; lens < 2; ++lens) {
+  for (size_t lens = 0; lens < circles.size(); ++lens) {
     text += lens_names[lens] + " " + ShortestDoubleText(circles[lens].cx) +
             " " + ShortestDoubleText(circles[lens].cy) + " " +
             ShortestDoubleText(circles[lens].r) + "\n";
   }
   return text;
+}
+
+// The fall-off ESTIMATOR fitted, logged for LENS_NAME.
+RadialFalloff FitFalloff(const RadialFalloffEstimator& estimator,
+                         const std::string& lens_name) {
+  std::string why;
+  const RadialFalloff falloff = estimator.Fit(3, 0.03, &why);
+  if (falloff.IsIdentity()) {
+    LOG(INFO) << "dual_fisheye_splitter: " << lens_name
+              << ": no light fall-off divided out (" << why << ")";
+  } else {
+    LOG(INFO) << "dual_fisheye_splitter: " << lens_name
+              << ": light fall-off from " << estimator.NumImages()
+              << " images, the rim at " << std::lround(100 * falloff.Gain(1))
+              << "% of the centre (1 + " << ShortestDoubleText(falloff.a)
+              << " rho^2 + " << ShortestDoubleText(falloff.b)
+              << " rho^4); divided out";
+  }
+  return falloff;
+}
+
+// Every STEP-th of COUNT images, so that at most 60 are read (evenly
+// spread) to estimate a lens's fall-off.
+size_t FalloffSampleStep(size_t count) {
+  return std::max<size_t>(1, (count + 59) / 60);
 }
 
 // Each lens's light fall-off from at most 60 of the frames (evenly spread),
@@ -777,31 +790,15 @@ std::array<RadialFalloff, 2> EstimateFalloffs(
   std::array<RadialFalloffEstimator, 2> estimators = {
       RadialFalloffEstimator(circles[0], black_level),
       RadialFalloffEstimator(circles[1], black_level)};
-  const size_t step = std::max<size_t>(1, (frames.size() + 59) / 60);
+  const size_t step = FalloffSampleStep(frames.size());
   for (size_t i = 0; i < frames.size(); i += step) {
     const std::array<cv::Mat, 2> lenses = ReadLensImages(frames[i]);
     for (int lens = 0; lens < 2; ++lens) {
       if (!lenses[lens].empty()) estimators[lens].Add(lenses[lens]);
     }
   }
-  std::array<RadialFalloff, 2> falloffs;
-  for (int lens = 0; lens < 2; ++lens) {
-    std::string why;
-    falloffs[lens] = estimators[lens].Fit(3, 0.03, &why);
-    if (falloffs[lens].IsIdentity()) {
-      LOG(INFO) << "dual_fisheye_splitter: " << lens_names[lens]
-                << ": no light fall-off divided out (" << why << ")";
-    } else {
-      LOG(INFO) << "dual_fisheye_splitter: " << lens_names[lens]
-                << ": light fall-off from " << estimators[lens].NumImages()
-                << " images, the rim at "
-                << std::lround(100 * falloffs[lens].Gain(1))
-                << "% of the centre (1 + " << ShortestDoubleText(falloffs[lens].a)
-                << " rho^2 + " << ShortestDoubleText(falloffs[lens].b)
-                << " rho^4); divided out";
-    }
-  }
-  return falloffs;
+  return {FitFalloff(estimators[0], lens_names[0]),
+          FitFalloff(estimators[1], lens_names[1])};
 }
 
 // The last pass: every output file under a temporary name, then renamed.
@@ -842,7 +839,9 @@ void WriteOutputs(const DualFisheyeSplittingOptions& options,
     }
   }
   staged.Write(out / "rig_config.json", rig_config);
-  staged.Write(out / "circles.txt", CirclesText(lens_names, circles));
+  staged.Write(out / "circles.txt",
+               CirclesText({lens_names[0], lens_names[1]},
+                           {circles[0], circles[1]}));
   staged.Commit();
 }
 
@@ -1001,9 +1000,11 @@ void WriteLensFiles(const DualFisheyeSplittingOptions& options,
                                 SizeText(*size) + ": " + error.what());
   }
   std::vector<ImageCircle> circles;
+  std::vector<std::string> lens_names;  // as circles.txt names them
   for (int lens = 0; lens < num_lenses; ++lens) {
     const sphera::PresetCircle& circle = resolution.circles.at(lens);
     circles.push_back({circle.cx, circle.cy, circle.r});
+    lens_names.push_back("lens" + std::to_string(lens + 1));
   }
   std::vector<std::string> existing;
   for (const fs::path& path : {out / "rig_config.json", out / "circles.txt"}) {
@@ -1032,39 +1033,19 @@ void WriteLensFiles(const DualFisheyeSplittingOptions& options,
         if (file.lens == lens) of_lens.push_back(&file);
       }
       RadialFalloffEstimator estimator(circles[lens], options.black_level);
-      const size_t step = std::max<size_t>(1, (of_lens.size() + 59) / 60);
+      const size_t step = FalloffSampleStep(of_lens.size());
       for (size_t i = 0; i < of_lens.size(); i += step) {
         estimator.Add(ReadImage(options.input_path / of_lens[i]->name));
       }
-      std::string why;
-      falloffs[lens] = estimator.Fit(3, 0.03, &why);
-      const std::string lens_name =
-          "lens " + std::to_string(lens + 1) + " (" +
-          preset.lenses[lens].file_suffix + ")";
-      if (falloffs[lens].IsIdentity()) {
-        LOG(INFO) << "dual_fisheye_splitter: " << lens_name
-                  << ": no light fall-off divided out (" << why << ")";
-      } else {
-        LOG(INFO) << "dual_fisheye_splitter: " << lens_name
-                  << ": light fall-off from " << estimator.NumImages()
-                  << " images, the rim at "
-                  << std::lround(100 * falloffs[lens].Gain(1))
-                  << "% of the centre; divided out";
-      }
+      falloffs[lens] = FitFalloff(estimator, lens_names[lens]);
     }
   }
 
   StagedOutput staged;
   std::vector<std::string> mask_bytes(num_lenses);
-  std::string circles_text = "# SENSOR CX CY R (pixels, image corner at 0, 0)\n";
   for (int lens = 0; lens < num_lenses; ++lens) {
     mask_bytes[lens] = EncodeImage(ImageCircleMask(*size, circles[lens]),
-                                   ".png", {},
-                                   "the mask of lens " + std::to_string(lens + 1));
-    circles_text += "lens" + std::to_string(lens + 1) + " " +
-                    ShortestDoubleText(circles[lens].cx) + " " +
-                    ShortestDoubleText(circles[lens].cy) + " " +
-                    ShortestDoubleText(circles[lens].r) + "\n";
+                                   ".png", {}, lens_names[lens] + "'s mask");
   }
   for (const LensFile& file : files) {
     const std::string extension = EncoderExtension(file.name);
@@ -1081,7 +1062,7 @@ void WriteLensFiles(const DualFisheyeSplittingOptions& options,
   staged.Write(out / "rig_config.json",
                sphera::PresetRigConfigJson(preset, resolution, {},
                                            options.camera_model));
-  staged.Write(out / "circles.txt", circles_text);
+  staged.Write(out / "circles.txt", CirclesText(lens_names, circles));
   staged.Commit();
   LOG(INFO) << "dual_fisheye_splitter: " << preset.name << " "
             << resolution.name << ": " << files.size() << " lens files of "
