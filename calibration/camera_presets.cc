@@ -271,9 +271,9 @@ std::vector<CameraPreset> MakePresets() {
 
   // Any camera of two circles side by side in square halves: inscribed
   // circles, 190° lenses back to back, 3 cm apart (the middle of the 2 to 4
-  // cm of the cameras above; the mapper refines it). Lenses at one centre
-  // make a hand-held, mostly turning capture a panorama whose frames cannot
-  // be triangulated from one another.
+  // cm of the cameras above; the mapper refines its direction). Lenses at
+  // one centre would make the rig a panorama, without the baseline its
+  // lens offset gives inside each frame.
   CameraPreset generic = SideBySideDualFisheye(
       "dual_fisheye",
       "any dual-fisheye camera: two 190° circles inscribed in the halves of "

@@ -10,23 +10,34 @@
 namespace colmap {
 namespace {
 
-// The pairs one seed tries: its second images, in order.
+// The pairs one seed tries: its second images, in order, and for each the
+// end of what trying it added to the tried set (an index into the batch's
+// list of added pair ids).
 struct SeedPlan {
   image_t seed = kInvalidImageId;
   std::vector<image_t> second;
+  std::vector<size_t> added_end;
 };
 
-// Marks (SEED, SECOND) tried in TRIED as the search does; false when it
-// was already.
+// Marks (SEED, SECOND) tried in TRIED as the search does, appending the ids
+// it adds to ADDED; false when the pair was tried already.
 bool MarkTried(const InitialPairSearch& search,
                image_t seed,
                image_t second,
-               FlatHashSet<image_pair_t>* tried) {
-  if (!tried->emplace(ImagePairToPairId(seed, second)).second) {
+               FlatHashSet<image_pair_t>* tried,
+               std::vector<image_pair_t>* added) {
+  const image_pair_t pair_id = ImagePairToPairId(seed, second);
+  if (tried->count(pair_id)) {
     return false;
   }
+  FlatHashSet<image_pair_t> marks = {pair_id};
   if (search.mark_tried) {
-    search.mark_tried(seed, second, tried);
+    search.mark_tried(seed, second, &marks);
+  }
+  for (const image_pair_t id : marks) {
+    if (tried->insert(id).second) {
+      added->push_back(id);
+    }
   }
   return true;
 }
@@ -45,13 +56,14 @@ std::optional<IncrementalMapperImpl::InitInfo> FindInitialPairInOrder(
     const size_t end = std::min(seeds.size(), begin + batch_size);
     // The pairs of each seed of the batch, planned as one thread tries
     // them, every seed before it having failed.
-    const FlatHashSet<image_pair_t> tried_before = *tried_pairs;
+    std::vector<image_pair_t> added;
     std::vector<SeedPlan> plans;
     for (size_t i = begin; i < end; ++i) {
-      SeedPlan plan{seeds[i], {}};
+      SeedPlan plan{seeds[i], {}, {}};
       for (const image_t second : search.second_images(seeds[i])) {
-        if (MarkTried(search, seeds[i], second, tried_pairs)) {
+        if (MarkTried(search, seeds[i], second, tried_pairs, &added)) {
           plan.second.push_back(second);
+          plan.added_end.push_back(added.size());
         }
       }
       plans.push_back(std::move(plan));
@@ -92,15 +104,11 @@ std::optional<IncrementalMapperImpl::InitInfo> FindInitialPairInOrder(
     if (!winner) {
       continue;  // every pair of the batch tried, as one thread would
     }
-    // The tried pairs as one thread leaves them: every pair of the seeds
-    // before the winner, and the winner's up to its good pair.
-    *tried_pairs = tried_before;
-    for (size_t k = 0; k <= winner_seed; ++k) {
-      const size_t count =
-          k < winner_seed ? plans[k].second.size() : winner->first + 1;
-      for (size_t j = 0; j < count; ++j) {
-        MarkTried(search, plans[k].seed, plans[k].second[j], tried_pairs);
-      }
+    // The tried pairs as one thread leaves them: those of the seeds before
+    // the winner and of the winner up to its good pair.
+    const size_t keep = plans[winner_seed].added_end[winner->first];
+    for (size_t i = keep; i < added.size(); ++i) {
+      tried_pairs->erase(added[i]);
     }
     return std::move(winner->second);
   }
