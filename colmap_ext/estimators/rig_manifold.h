@@ -37,7 +37,7 @@ class RotationAboutCentreManifold : public ceres::Manifold {
     const Eigen::Quaterniond q(x);
     const Eigen::Quaterniond q_plus(x_plus_delta);
     Eigen::Map<Eigen::Vector3d>(x_plus_delta + 4) =
-        (q_plus * q.conjugate()) * Eigen::Map<const Eigen::Vector3d>(x + 4);
+        (q_plus * q.inverse()) * Eigen::Map<const Eigen::Vector3d>(x + 4);
     return true;
   }
 
