@@ -30,7 +30,10 @@
 #                                        with the lenses' intrinsics held,
 #                                        into sparse_held/, kept if its
 #                                        largest model holds more images)
-#                                        and the rig's calibration
+#                                        and the rig's calibration, with a
+#                                        line for a lens whose axis the
+#                                        mapper and rig_check put more than
+#                                        2 degrees apart
 #
 # It prints one line per stage with its counts (images extracted, pairs
 # verified, images registered), a progress line while a stage runs on a
@@ -355,18 +358,45 @@ for model in "${sparse_dir}"/*/; do
 done
 if [ -f "${WORK_DIR}/rig_calibration/rig_config.json" ]; then
   echo "--- the rig (colmap rig_calibration) ---"
-  sed -n '/^=== rig calibration/,$p' "${LOG}" | awk '
+  rig_lines="$(sed -n '/^=== rig calibration/,$p' "${LOG}" | awk '
     /^Rig [0-9]+: .*\(lengths in / {
       units = $0; sub(/^[^(]*\(/, "", units); sub(/\)$/, "", units)
       print units }
     /^  [^ ].* \(camera [0-9]+,/ { lens = $1 }
-    /pose in the rig:/ { sub(/.*pose in the rig: /, ""); print lens ": " $0 }'
+    /pose in the rig:/ { sub(/.*pose in the rig: /, ""); print lens ": " $0 }')"
   # The lens axes the matches inside frames measured (colmap rig_check),
   # before mapping: a second reading of the same lenses.
-  sed -n '/^=== rig check/,/^=== mapping/p' "${LOG}" | awk '
+  check_lines="$(sed -n '/^=== rig check/,/^=== mapping/p' "${LOG}" | awk '
     /measured axis at/ {
       lens = $0; sub(/^[^(]*\(/, "", lens); sub(/\/?\).*/, "", lens)
       axis = $0; sub(/.*measured axis at /, "", axis)
-      print lens ": matches inside frames put its axis at " axis }'
+      print lens ": matches inside frames put its axis at " axis }')"
+  echo "${rig_lines}"
+  [ -z "${check_lines}" ] || echo "${check_lines}"
+  # Two readings of a lens's axis more than 2 degrees apart: the capture
+  # did not pin the lens in the rig (too short, or turning in place).
+  printf '%s\n%s\n' "${rig_lines}" "${check_lines}" | awk '
+    function direction(line, parts) {
+      match(line, /azimuth -?[0-9.]+ deg, elevation -?[0-9.]+/)
+      split(substr(line, RSTART, RLENGTH), parts, " ")
+      return parts[2] " " parts[5]
+    }
+    /: turned .*its axis at azimuth/ { mapped[$1] = direction($0) }
+    /: matches inside frames put its axis at/ { checked[$1] = direction($0) }
+    END {
+      rad = atan2(0, -1) / 180
+      for (lens in checked) {
+        if (!(lens in mapped)) continue
+        split(mapped[lens], m, " "); split(checked[lens], c, " ")
+        cosine = sin(m[2] * rad) * sin(c[2] * rad) + \
+          cos(m[2] * rad) * cos(c[2] * rad) * cos((m[1] - c[1]) * rad)
+        if (cosine > 1) cosine = 1
+        angle = atan2(sqrt(1 - cosine * cosine), cosine) / rad
+        if (angle > 2)
+          printf "%s the two readings of its axis are %.1f deg apart: the" \
+            " capture does not pin the lens in the rig (more frames, moved" \
+            " between, not turned in place)\n", lens, angle
+      }
+    }'
 fi
 echo "log: ${LOG}"

@@ -30,6 +30,37 @@ def registered(output):
     return int(largest), int(total), int(one or several)
 
 
+def check_axis_readings(test, output):
+    """The demo names a lens whose axis the mapper (rig_calibration) and the
+    matches inside frames (rig_check) put more than 2° apart, and only
+    such a lens; returns the lenses' angles."""
+    import numpy as np
+    number = r"(-?[0-9.]+)"
+    axis = rf"azimuth {number} deg, elevation {number}"
+    mapped = {lens: tuple(map(float, m)) for lens, *m in re.findall(
+        rf"^(lens[0-9]+): turned .*its axis at {axis}", output,
+        re.MULTILINE)}
+    checked = {lens: tuple(map(float, c)) for lens, *c in re.findall(
+        rf"^(lens[0-9]+): matches inside frames put its axis at {axis}",
+        output, re.MULTILINE)}
+    angles = {}
+    for lens in set(mapped) & set(checked):
+        (a1, e1), (a2, e2) = (np.radians(mapped[lens]),
+                              np.radians(checked[lens]))
+        cosine = (np.sin(e1) * np.sin(e2)
+                  + np.cos(e1) * np.cos(e2) * np.cos(a1 - a2))
+        angles[lens] = float(np.degrees(np.arccos(min(1.0, cosine))))
+        named = re.search(rf"^{lens}: the two readings of its axis are "
+                          rf"([0-9.]+) deg apart", output, re.MULTILINE)
+        if angles[lens] > 2.05:
+            test.assertIsNotNone(named, output)
+            test.assertAlmostEqual(float(named.group(1)), angles[lens],
+                                   delta=0.06)
+        elif angles[lens] < 1.95:
+            test.assertIsNone(named, output)
+    return angles
+
+
 def back_lens_pose(model):
     """(R sensor_from_rig, centre in the rig) of the one non-reference lens
     of MODEL's one rig."""
@@ -123,6 +154,7 @@ class DemoCameraTest(TempDirTestCase):
         turn = back_lens_turn(output)
         self.assertIsNotNone(turn, output)
         self.assertGreater(turn, 150, output)
+        check_axis_readings(self, output)
         # The lengths are the rig config's scale, and the summary says so.
         self.assertIn("lengths in the model's units: the mapper scales a "
                       "rig model so that its lens offsets are on average "
@@ -215,6 +247,9 @@ class DemoCameraTest(TempDirTestCase):
                           r"deg$", output, re.MULTILINE)
         self.assertIsNotNone(match, output)
         self.assertGreater(abs(float(match.group(1))), 179, output)
+        # Both readings of the back lens's axis are printed; when they part
+        # by more than 2° the demo says so.
+        self.assertIn("lens1", check_axis_readings(self, output))
 
         # A short capture's self-calibration can split the run: the demo
         # then maps again with the preset's intrinsics held and keeps that
