@@ -12,9 +12,9 @@ import shutil
 
 from cli_util import TempDirTestCase, main_with_render
 from demo_test import MAX_LINES, run_demo
-from sphera_common import (REPO_ROOT, model_counts, model_to_text,
-                           read_text_rigs, rotation_from_quaternion,
-                           run_colmap, run_render)
+from sphera_common import (REPO_ROOT, axis_rotation, model_counts,
+                           model_to_text, quaternion_from_matrix,
+                           run_colmap, run_render, sensors_by_folder)
 
 FUSION_3K = os.path.abspath(os.path.join(
     REPO_ROOT, "..", "shared", "data", "real_cameras", "gopro_fusion_3k"))
@@ -62,39 +62,11 @@ def check_axis_readings(test, output):
 
 
 def back_lens_pose(model):
-    """(R sensor_from_rig, centre in the rig) of the one non-reference lens
-    of MODEL's one rig."""
-    text = model_to_text(model, model + "_text")
-    (rig,) = read_text_rigs(text).values()
-    (rotation, translation), = [pose for pose in rig.values()
-                                if pose is not None and pose[1].any()]
+    """(R sensor_from_rig, centre in the rig) of MODEL's back lens (its
+    images under lens1/)."""
+    rotation, translation = sensors_by_folder(
+        model_to_text(model, model + "_text"))["lens1"]
     return rotation, -rotation.T @ translation
-
-
-def rotation_from_axis_angle(axis, angle):
-    import numpy as np
-    k = np.asarray(axis, float) / np.linalg.norm(axis)
-    cross = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return (np.eye(3) + np.sin(angle) * cross
-            + (1 - np.cos(angle)) * cross @ cross)
-
-
-def quaternion_from_rotation(r):
-    """(qw, qx, qy, qz) of the rotation matrix R."""
-    import numpy as np
-    if np.trace(r) > 0:
-        w = np.sqrt(1 + np.trace(r)) / 2
-        return (w, (r[2, 1] - r[1, 2]) / (4 * w),
-                (r[0, 2] - r[2, 0]) / (4 * w), (r[1, 0] - r[0, 1]) / (4 * w))
-    # Turns beyond 90°: from the largest diagonal element (Shepperd).
-    i = int(np.argmax(np.diag(r)))
-    j, k = (i + 1) % 3, (i + 2) % 3
-    q = np.zeros(4)
-    q[1 + i] = np.sqrt(max(0.0, 1 + r[i, i] - r[j, j] - r[k, k])) / 2
-    q[0] = (r[k, j] - r[j, k]) / (4 * q[1 + i])
-    q[1 + j] = (r[j, i] + r[i, j]) / (4 * q[1 + i])
-    q[1 + k] = (r[k, i] + r[i, k]) / (4 * q[1 + i])
-    return tuple(q)
 
 
 def angle_deg(u, v):
@@ -170,14 +142,14 @@ class DemoCameraTest(TempDirTestCase):
         import numpy as np
         true_rotation, true_centre = back_lens_pose(
             os.path.join(scene, "sparse_gt"))
-        turn = rotation_from_axis_angle([0, 1, 0], np.radians(2))
+        turn = np.array(axis_rotation(1, np.radians(2)))
         start_rotation = true_rotation @ turn
         start_centre = true_centre + np.array([0.005, 0, 0])
         with open(os.path.join(scene, "rig_config.json")) as f:
             config = json.load(f)
         back = config[0]["cameras"][1]
         back["cam_from_rig_rotation"] = list(
-            quaternion_from_rotation(start_rotation))
+            quaternion_from_matrix(start_rotation))
         back["cam_from_rig_translation"] = list(
             -start_rotation @ start_centre)
         with open(self.path("off_config.json"), "w") as f:
