@@ -435,6 +435,18 @@ TEST(FieldOfView, EUCMVisibleSetIsInjectivityLimit) {
   }
 }
 
+TEST(EUCM, ImageInFrontOfImagePlaneMatchesScan) {
+  // Rays with z = 0 land 1 / (alpha sqrt(beta)) from the axis: 477, 461 and
+  // 522 px at f = 300.
+  for (const auto& [alpha, beta] : std::vector<std::pair<double, double>>{
+           {0.6, 1.1}, {0.62, 1.1}, {0.5, 1.32}}) {
+    test::ExpectImageInFrontMatchesScan<EUCMModel>(
+        {300, 301, 320.3, 320.2, alpha, beta});
+  }
+  const std::vector<double> pinhole = {300, 300, 320, 320, 0.0, 1.0};
+  EXPECT_TRUE(EUCMModel::ImageInFrontOfImagePlane(pinhole.data(), 4000, 4000));
+}
+
 TEST(FieldOfView, DoubleSphereVisibleSetIsInjectivityLimit) {
   for (const auto& [xi, alpha] : std::vector<std::pair<double, double>>{
            {-0.2, 0.6}, {0.0, 0.5}, {0.5, 0.3}, {0.9, 0.7}, {-0.5, 0.8},

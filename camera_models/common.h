@@ -3,6 +3,7 @@
 // parameter validation messages.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <iomanip>
@@ -153,6 +154,22 @@ bool UndistortRadTan(const T* k, const T& ud, const T& vd, T* u, T* v) {
     *v = root_v - step_v;
     return true;
   }
+}
+
+// The largest normalized radius |((px - cx) / fx, (py - cy) / fy)| over the
+// pixels of a width x height image, for models with fx, fy, cx, cy at indices
+// 0-3: the radius is convex in the pixel, so one of the four corners of the
+// image domain [0, width] x [0, height] holds it.
+inline double MaxNormalizedCornerRadius(const double* params, int width,
+                                        int height) {
+  double max_radius = 0;
+  for (const double px : {0.0, static_cast<double>(width)}) {
+    for (const double py : {0.0, static_cast<double>(height)}) {
+      max_radius = std::max(max_radius, std::hypot((px - params[2]) / params[0],
+                                                   (py - params[3]) / params[1]));
+    }
+  }
+  return max_radius;
 }
 
 // ---------------------------------------------------------------------------

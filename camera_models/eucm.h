@@ -78,6 +78,18 @@ struct EUCMModel {
     return internal::NormalizeRay(mx, my, mz, ray_in_cam);
   }
 
+  // Whether every pixel of a width x height image sees a ray with z > 0: the
+  // image radius of the rays with z = 0 is 1 / (alpha sqrt(beta)) (infinite
+  // for alpha = 0, the pinhole), and |m| grows with the angle from the axis,
+  // so the corner farthest from the principal point decides.
+  static bool ImageInFrontOfImagePlane(const double* params, int width,
+                                       int height) {
+    if (width <= 0 || height <= 0) return false;
+    return params[4] * std::sqrt(params[5]) *
+               internal::MaxNormalizedCornerRadius(params, width, height) <
+           1.0;
+  }
+
   // Near the axis d ~ z and den ~ z: a pinhole with focal mean(fx, fy).
   static double PixelToAngle(const double* params) {
     return 2.0 / (params[0] + params[1]);

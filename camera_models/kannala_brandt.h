@@ -30,6 +30,11 @@
 // locally. CheckParams refuses parameters whose fold lies inside the image
 // circle (fold.h).
 //
+// Image in front of the image plane. When every pixel of the image sees a ray
+// with theta < 90° (ImageInFrontOfImagePlane), the lens is one upstream's
+// perspective models cover, and COLMAP treats it as upstream does
+// (colmap_ext/scene/camera_category.h).
+//
 // Unprojection, m = ((px - cx) / fx, (py - cy) / fy): OPENCV_FISHEYE solves
 // r(theta) = |m| on [0, theta_max) by safeguarded Newton; THIN_PRISM_FISHEYE
 // inverts (a, b) -> (ad, bd) by Newton's method started from the radial
@@ -304,6 +309,18 @@ struct OpenCVFisheyeModel {
     return internal::KannalaBrandtFieldOfView(k);
   }
 
+  // Whether every pixel of a width x height image sees a ray with theta < 90°
+  // (or none, beyond a fold before 90°). |m| = r(theta) is monotone below
+  // theta_max, so the corner farthest from the principal point decides.
+  static bool ImageInFrontOfImagePlane(const double* params, int width,
+                                       int height) {
+    if (width <= 0 || height <= 0) return false;
+    constexpr double kHalfPi = internal::kPi / 2;
+    if (FieldOfView(params).theta_max <= kHalfPi) return true;
+    return internal::MaxNormalizedCornerRadius(params, width, height) <
+           internal::KannalaBrandtRadius(params + 4, kHalfPi);
+  }
+
   static std::string CheckParams(const std::vector<double>& params, int width,
                                  int height) {
     using namespace internal;
@@ -405,6 +422,26 @@ struct ThinPrismFisheyeModel {
         internal::ScalarPart(params[4]), internal::ScalarPart(params[5]),
         internal::ScalarPart(params[8]), internal::ScalarPart(params[9])};
     return internal::KannalaBrandtFieldOfView(k);
+  }
+
+  // Whether every pixel of a width x height image sees a ray with theta < 90°
+  // (or none, beyond a fold before 90°). The tangential and prism terms are a
+  // small smooth shift of the radial map, so the farthest pixels are still
+  // the corners: each corner's ray decides.
+  static bool ImageInFrontOfImagePlane(const double* params, int width,
+                                       int height) {
+    if (width <= 0 || height <= 0) return false;
+    const bool folds_in_front = FieldOfView(params).theta_max <= internal::kPi / 2;
+    for (const double px : {0.0, static_cast<double>(width)}) {
+      for (const double py : {0.0, static_cast<double>(height)}) {
+        const double pixel[2] = {px, py};
+        double ray[3];
+        if (RayFromImage(params, pixel, ray) ? ray[2] <= 0 : !folds_in_front) {
+          return false;
+        }
+      }
+    }
+    return true;
   }
 
   // Newton's method on (a, b) -> (ad, bd) from the radial-only solution; a

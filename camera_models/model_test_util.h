@@ -154,5 +154,51 @@ void ExpectAutodiffMatchesCentralDifferences(const std::vector<double>& params,
                            "RayFromImage d/dparams");
 }
 
+// Whether a dense scan of the image domain (every 4 px and its far edges)
+// finds only pixels whose rays lie in front of the image plane or that have
+// no ray: the reference for ImageInFrontOfImagePlane.
+template <typename Model>
+bool ScannedImageInFront(const std::vector<double>& params, int width,
+                         int height) {
+  for (int ix = 0; ix <= width; ix += 4) {
+    for (int iy = 0; iy <= height; iy += 4) {
+      for (const double px : {double(ix), double(std::min(ix + 1, width))}) {
+        for (const double py :
+             {double(iy), double(std::min(iy + 1, height))}) {
+          const double pixel[2] = {px, py};
+          double ray[3];
+          if (Model::RayFromImage(params.data(), pixel, ray) && ray[2] <= 0) {
+            return false;
+          }
+        }
+      }
+    }
+  }
+  return true;
+}
+
+// Images of sizes whose corners reach from well inside to well beyond 90° off
+// the axis (369 to 531 px from the centre) for lenses of focal length ~300 px,
+// each with the principal point near its centre: ImageInFrontOfImagePlane
+// must agree with the scan on each, and both answers must occur.
+template <typename Model>
+void ExpectImageInFrontMatchesScan(std::vector<double> params) {
+  int in_front = 0;
+  int behind = 0;
+  for (int width = 560; width <= 800; width += 12) {
+    for (int height : {480, 640, 700}) {
+      params[2] = width / 2.0 + 0.3;
+      params[3] = height / 2.0 + 0.2;
+      const bool expected = ScannedImageInFront<Model>(params, width, height);
+      EXPECT_EQ(Model::ImageInFrontOfImagePlane(params.data(), width, height),
+                expected)
+          << width << " x " << height;
+      (expected ? in_front : behind) += 1;
+    }
+  }
+  EXPECT_GT(in_front, 0);
+  EXPECT_GT(behind, 0);
+}
+
 }  // namespace test
 }  // namespace sphera

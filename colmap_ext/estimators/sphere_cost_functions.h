@@ -37,6 +37,7 @@
 #include "colmap/estimators/cost_functions/reprojection_error.h"
 #include "colmap/scene/camera.h"
 #include "colmap_ext/estimators/sphere_residual_type.h"
+#include "colmap_ext/scene/camera_category.h"
 
 #include "camera_models/common.h"
 #include "camera_models/equirectangular.h"
@@ -524,9 +525,57 @@ struct AngularFunctorOf<RigReprojErrorConstantRigCostFunctor> {
   using type = AngularRigReprojErrorConstantRigCostFunction<M>;
 };
 
+// The pixel cost of upstream's CameraModel exactly as CreateCameraCostFunction
+// makes it: analytic where upstream has it, else the functor.
+template <template <typename> class PixelFunctor,
+          typename CameraModel,
+          typename... Args>
+ceres::CostFunction* CreateUpstreamModelCostFunction(Args&&... args) {
+  if constexpr (std::is_same_v<PixelFunctor<CameraModel>,
+                               ReprojErrorCostFunctor<CameraModel>> &&
+                CameraModel::has_img_from_cam_with_jac) {
+    return CreateAnalyticalReprojErrorCostFunction<CameraModel>(
+        std::forward<Args>(args)...);
+  } else if constexpr (std::is_same_v<
+                           PixelFunctor<CameraModel>,
+                           ReprojErrorConstantPoseCostFunctor<CameraModel>> &&
+                       CameraModel::has_img_from_cam_with_jac) {
+    return CreateAnalyticalReprojErrorConstantPoseCostFunction<CameraModel>(
+        std::forward<Args>(args)...);
+  } else {
+    return PixelFunctor<CameraModel>::Create(std::forward<Args>(args)...);
+  }
+}
+
+// The pixel cost of upstream's model of the same id as CAMERA's whole-field
+// model, for a camera whose image lies in front of its image plane
+// (camera_category.h): the same projection there, with upstream's own
+// Jacobians.
+template <template <typename> class PixelFunctor, typename... Args>
+ceres::CostFunction* CreateInFrontCameraCostFunction(const Camera& camera,
+                                                     Args&&... args) {
+  switch (camera.model_id) {
+    case OpenCVFisheyeCameraModel::model_id:
+      return CreateUpstreamModelCostFunction<PixelFunctor,
+                                             OpenCVFisheyeCameraModel>(
+          std::forward<Args>(args)...);
+    case ThinPrismFisheyeCameraModel::model_id:
+      return CreateUpstreamModelCostFunction<PixelFunctor,
+                                             ThinPrismFisheyeCameraModel>(
+          std::forward<Args>(args)...);
+    case EUCMCameraModel::model_id:
+      return CreateUpstreamModelCostFunction<PixelFunctor, EUCMCameraModel>(
+          std::forward<Args>(args)...);
+    default:
+      return CreateCameraCostFunction<PixelFunctor>(
+          camera.model_id, std::forward<Args>(args)...);
+  }
+}
+
 // CreateCameraCostFunction<PixelFunctor>, with the angular residual in its
 // place for a spherical camera when `residual` is ANGULAR, in the pixels of
-// CAMERA's parameters as they are now.
+// CAMERA's parameters as they are now. A whole-field camera whose image lies
+// in front of its image plane is not spherical and gets upstream's cost.
 template <template <typename> class PixelFunctor, typename... Args>
 ceres::CostFunction* CreateSphereCameraCostFunction(
     const SphereResidualType residual, const Camera& camera, Args&&... args) {
@@ -534,6 +583,10 @@ ceres::CostFunction* CreateSphereCameraCostFunction(
     return CreateCameraCostFunction<
         AngularFunctorOf<PixelFunctor>::template type>(
         camera.model_id, camera.params.data(), std::forward<Args>(args)...);
+  }
+  if (InFrontCameraCategory(camera) != UpstreamCategory::kNone) {
+    return CreateInFrontCameraCostFunction<PixelFunctor>(
+        camera, std::forward<Args>(args)...);
   }
   return CreateCameraCostFunction<PixelFunctor>(camera.model_id,
                                                 std::forward<Args>(args)...);

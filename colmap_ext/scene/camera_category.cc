@@ -1,0 +1,61 @@
+#include "colmap_ext/scene/camera_category.h"
+
+#include "camera_models/eucm.h"
+#include "camera_models/kannala_brandt.h"
+
+#include <type_traits>
+
+namespace colmap {
+namespace {
+
+// MODEL (camera_models/) with its image in front: the category of UPSTREAM,
+// upstream's model struct of the same id.
+template <typename Model, typename UpstreamModel>
+UpstreamCategory CategoryInFront(const std::vector<double>& params,
+                                 const size_t width,
+                                 const size_t height) {
+  static_assert(static_cast<int>(UpstreamModel::model_id) == Model::kModelId);
+  if (params.size() != static_cast<size_t>(Model::kNumParams) ||
+      !Model::ImageInFrontOfImagePlane(params.data(),
+                                       static_cast<int>(width),
+                                       static_cast<int>(height))) {
+    return UpstreamCategory::kNone;
+  }
+  if constexpr (std::is_base_of_v<
+                    BasePerspectiveFisheyeCameraModel<UpstreamModel>,
+                    UpstreamModel>) {
+    return UpstreamCategory::kPerspectiveFisheye;
+  } else {
+    static_assert(std::is_base_of_v<
+                  BasePerspectivePinholeCameraModel<UpstreamModel>,
+                  UpstreamModel>);
+    return UpstreamCategory::kPerspectivePinhole;
+  }
+}
+
+}  // namespace
+
+UpstreamCategory InFrontCameraCategory(const Camera& camera) {
+  if (!camera.has_prior_focal_length) {
+    return UpstreamCategory::kNone;
+  }
+  const std::vector<double>& params = camera.params;
+  const size_t width = camera.width;
+  const size_t height = camera.height;
+  switch (static_cast<int>(camera.model_id)) {
+    case sphera::OpenCVFisheyeModel::kModelId:
+      return CategoryInFront<sphera::OpenCVFisheyeModel,
+                             OpenCVFisheyeCameraModel>(params, width, height);
+    case sphera::ThinPrismFisheyeModel::kModelId:
+      return CategoryInFront<sphera::ThinPrismFisheyeModel,
+                             ThinPrismFisheyeCameraModel>(
+          params, width, height);
+    case sphera::EUCMModel::kModelId:
+      return CategoryInFront<sphera::EUCMModel, EUCMCameraModel>(
+          params, width, height);
+    default:
+      return UpstreamCategory::kNone;
+  }
+}
+
+}  // namespace colmap
