@@ -435,16 +435,16 @@ TEST(FieldOfView, EUCMVisibleSetIsInjectivityLimit) {
   }
 }
 
-TEST(EUCM, ImageInFrontOfImagePlaneMatchesScan) {
+TEST(EUCM, FieldInFrontOfImagePlaneMatchesScan) {
   // Rays with z = 0 land 1 / (alpha sqrt(beta)) from the axis: 477, 461 and
   // 522 px at f = 300.
   for (const auto& [alpha, beta] : std::vector<std::pair<double, double>>{
            {0.6, 1.1}, {0.62, 1.1}, {0.5, 1.32}}) {
-    test::ExpectImageInFrontMatchesScan<EUCMModel>(
+    test::ExpectFieldInFrontMatchesScan<EUCMModel>(
         {300, 301, 320.3, 320.2, alpha, beta});
   }
   const std::vector<double> pinhole = {300, 300, 320, 320, 0.0, 1.0};
-  EXPECT_TRUE(EUCMModel::ImageInFrontOfImagePlane(pinhole.data(), 4000, 4000));
+  EXPECT_TRUE(EUCMModel::FieldInFrontOfImagePlane(pinhole.data(), 4000, 4000));
 }
 
 TEST(FieldOfView, DoubleSphereVisibleSetIsInjectivityLimit) {

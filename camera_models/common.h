@@ -156,20 +156,15 @@ bool UndistortRadTan(const T* k, const T& ud, const T& vd, T* u, T* v) {
   }
 }
 
-// The largest normalized radius |((px - cx) / fx, (py - cy) / fy)| over the
-// pixels of a width x height image, for models with fx, fy, cx, cy at indices
-// 0-3: the radius is convex in the pixel, so one of the four corners of the
-// image domain [0, width] x [0, height] holds it.
-inline double MaxNormalizedCornerRadius(const double* params, int width,
-                                        int height) {
-  double max_radius = 0;
-  for (const double px : {0.0, static_cast<double>(width)}) {
-    for (const double py : {0.0, static_cast<double>(height)}) {
-      max_radius = std::max(max_radius, std::hypot((px - params[2]) / params[0],
-                                                   (py - params[3]) / params[1]));
-    }
-  }
-  return max_radius;
+// The radius, in normalized coordinates ((px - cx) / fx, (py - cy) / fy), of
+// the image circle a width x height frame shows about the principal point: the
+// disc that reaches the frame's farthest edge. A fisheye's image circle lies
+// inside it, whether the circle is whole in the frame or cropped by two of its
+// edges (the corners beyond it are dark); only a full-frame fisheye shows
+// rays beyond it, in the corners.
+inline double FrameCircleRadius(const double* params, int width, int height) {
+  return std::max(std::max(params[2], width - params[2]) / params[0],
+                  std::max(params[3], height - params[3]) / params[1]);
 }
 
 // ---------------------------------------------------------------------------

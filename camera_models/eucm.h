@@ -78,15 +78,15 @@ struct EUCMModel {
     return internal::NormalizeRay(mx, my, mz, ray_in_cam);
   }
 
-  // Whether every pixel of a width x height image sees a ray with z > 0: the
-  // image radius of the rays with z = 0 is 1 / (alpha sqrt(beta)) (infinite
-  // for alpha = 0, the pinhole), and |m| grows with the angle from the axis,
-  // so the corner farthest from the principal point decides.
-  static bool ImageInFrontOfImagePlane(const double* params, int width,
+  // Whether every pixel of the image circle a width x height frame shows
+  // (common.h, FrameCircleRadius) sees a ray with z > 0: the image radius of
+  // the rays with z = 0 is 1 / (alpha sqrt(beta)) (infinite for alpha = 0,
+  // the pinhole), and |m| grows with the angle from the axis.
+  static bool FieldInFrontOfImagePlane(const double* params, int width,
                                        int height) {
     if (width <= 0 || height <= 0) return false;
     return params[4] * std::sqrt(params[5]) *
-               internal::MaxNormalizedCornerRadius(params, width, height) <
+               internal::FrameCircleRadius(params, width, height) <
            1.0;
   }
 

@@ -30,9 +30,10 @@
 // locally. CheckParams refuses parameters whose fold lies inside the image
 // circle (fold.h).
 //
-// Image in front of the image plane. When every pixel of the image sees a ray
-// with theta < 90° (ImageInFrontOfImagePlane), the lens is one upstream's
-// perspective models cover, and COLMAP treats it as upstream does
+// Field in front of the image plane. When every pixel of the image circle the
+// frame shows (common.h, FrameCircleRadius) sees a ray with theta < 90°
+// (FieldInFrontOfImagePlane), the lens is one upstream's perspective models
+// cover, and COLMAP treats it as upstream does
 // (colmap_ext/scene/camera_category.h).
 //
 // Unprojection, m = ((px - cx) / fx, (py - cy) / fy): OPENCV_FISHEYE solves
@@ -309,15 +310,15 @@ struct OpenCVFisheyeModel {
     return internal::KannalaBrandtFieldOfView(k);
   }
 
-  // Whether every pixel of a width x height image sees a ray with theta < 90°
-  // (or none, beyond a fold before 90°). |m| = r(theta) is monotone below
-  // theta_max, so the corner farthest from the principal point decides.
-  static bool ImageInFrontOfImagePlane(const double* params, int width,
+  // Whether every pixel of the image circle a width x height frame shows
+  // sees a ray with theta < 90° (or none, beyond a fold before 90°):
+  // |m| = r(theta) is monotone below theta_max.
+  static bool FieldInFrontOfImagePlane(const double* params, int width,
                                        int height) {
     if (width <= 0 || height <= 0) return false;
     constexpr double kHalfPi = internal::kPi / 2;
     if (FieldOfView(params).theta_max <= kHalfPi) return true;
-    return internal::MaxNormalizedCornerRadius(params, width, height) <
+    return internal::FrameCircleRadius(params, width, height) <
            internal::KannalaBrandtRadius(params + 4, kHalfPi);
   }
 
@@ -424,21 +425,23 @@ struct ThinPrismFisheyeModel {
     return internal::KannalaBrandtFieldOfView(k);
   }
 
-  // Whether every pixel of a width x height image sees a ray with theta < 90°
-  // (or none, beyond a fold before 90°). The tangential and prism terms are a
-  // small smooth shift of the radial map, so the farthest pixels are still
-  // the corners: each corner's ray decides.
-  static bool ImageInFrontOfImagePlane(const double* params, int width,
+  // Whether every pixel of the image circle a width x height frame shows
+  // sees a ray with theta < 90° (or none, beyond a fold before 90°). The
+  // tangential and prism terms are a small smooth shift of the radial map:
+  // the rays of the circle's rim in 16 directions decide.
+  static bool FieldInFrontOfImagePlane(const double* params, int width,
                                        int height) {
     if (width <= 0 || height <= 0) return false;
-    const bool folds_in_front = FieldOfView(params).theta_max <= internal::kPi / 2;
-    for (const double px : {0.0, static_cast<double>(width)}) {
-      for (const double py : {0.0, static_cast<double>(height)}) {
-        const double pixel[2] = {px, py};
-        double ray[3];
-        if (RayFromImage(params, pixel, ray) ? ray[2] <= 0 : !folds_in_front) {
-          return false;
-        }
+    const bool folds_in_front =
+        FieldOfView(params).theta_max <= internal::kPi / 2;
+    const double radius = internal::FrameCircleRadius(params, width, height);
+    for (int i = 0; i < 16; ++i) {
+      const double phi = i * internal::kPi / 8;
+      const double pixel[2] = {params[2] + params[0] * radius * std::cos(phi),
+                               params[3] + params[1] * radius * std::sin(phi)};
+      double ray[3];
+      if (RayFromImage(params, pixel, ray) ? ray[2] <= 0 : !folds_in_front) {
+        return false;
       }
     }
     return true;

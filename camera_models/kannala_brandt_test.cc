@@ -380,22 +380,22 @@ TEST(OpenCVFisheye, FoldFreeLensSeesAlmostEverything) {
                                                 ray.data()));
 }
 
-TEST(OpenCVFisheye, ImageInFrontOfImagePlaneMatchesScan) {
-  test::ExpectImageInFrontMatchesScan<OpenCVFisheyeModel>(kEquidistant);
-  test::ExpectImageInFrontMatchesScan<OpenCVFisheyeModel>(kFisheye);
+TEST(OpenCVFisheye, FieldInFrontOfImagePlaneMatchesScan) {
+  test::ExpectFieldInFrontMatchesScan<OpenCVFisheyeModel>(kEquidistant);
+  test::ExpectFieldInFrontMatchesScan<OpenCVFisheyeModel>(kFisheye);
   // A lens that folds at 85°: no pixel of any image sees a ray behind it.
   const std::vector<double> folds_early = {300, 300, 320, 320,
                                            -0.15, 0, 0, 0};
   ASSERT_LT(OpenCVFisheyeModel::FieldOfView(folds_early.data()).theta_max,
             kPi / 2);
-  EXPECT_TRUE(OpenCVFisheyeModel::ImageInFrontOfImagePlane(folds_early.data(),
+  EXPECT_TRUE(OpenCVFisheyeModel::FieldInFrontOfImagePlane(folds_early.data(),
                                                            4000, 4000));
   EXPECT_FALSE(
-      OpenCVFisheyeModel::ImageInFrontOfImagePlane(kEquidistant.data(), 0, 0));
+      OpenCVFisheyeModel::FieldInFrontOfImagePlane(kEquidistant.data(), 0, 0));
 }
 
-TEST(ThinPrismFisheye, ImageInFrontOfImagePlaneMatchesScan) {
-  test::ExpectImageInFrontMatchesScan<ThinPrismFisheyeModel>(kThinPrism);
+TEST(ThinPrismFisheye, FieldInFrontOfImagePlaneMatchesScan) {
+  test::ExpectFieldInFrontMatchesScan<ThinPrismFisheyeModel>(kThinPrism);
 }
 
 TEST(OpenCVFisheye, CheckParamsReportsFoldInsideImageCircle) {

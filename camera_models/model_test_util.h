@@ -154,43 +154,53 @@ void ExpectAutodiffMatchesCentralDifferences(const std::vector<double>& params,
                            "RayFromImage d/dparams");
 }
 
-// Whether a dense scan of the image domain (every 4 px and its far edges)
-// finds only pixels whose rays lie in front of the image plane or that have
-// no ray: the reference for ImageInFrontOfImagePlane.
+// Whether a dense scan of the image circle a width x height frame shows
+// (every 4 px inside it and 720 points of its rim) finds only pixels whose
+// rays lie in front of the image plane or that have no ray: the reference
+// for FieldInFrontOfImagePlane.
 template <typename Model>
-bool ScannedImageInFront(const std::vector<double>& params, int width,
+bool ScannedFieldInFront(const std::vector<double>& params, int width,
                          int height) {
-  for (int ix = 0; ix <= width; ix += 4) {
-    for (int iy = 0; iy <= height; iy += 4) {
-      for (const double px : {double(ix), double(std::min(ix + 1, width))}) {
-        for (const double py :
-             {double(iy), double(std::min(iy + 1, height))}) {
-          const double pixel[2] = {px, py};
-          double ray[3];
-          if (Model::RayFromImage(params.data(), pixel, ray) && ray[2] <= 0) {
-            return false;
-          }
-        }
+  const double fx = params[0], fy = params[1], cx = params[2], cy = params[3];
+  const double radius =
+      std::max(std::max(cx, width - cx) / fx, std::max(cy, height - cy) / fy);
+  std::vector<Eigen::Vector2d> pixels;
+  for (double px = cx - radius * fx; px <= cx + radius * fx; px += 4) {
+    for (double py = cy - radius * fy; py <= cy + radius * fy; py += 4) {
+      if (std::hypot((px - cx) / fx, (py - cy) / fy) <= radius) {
+        pixels.emplace_back(px, py);
       }
+    }
+  }
+  for (int i = 0; i < 720; ++i) {
+    const double phi = i * M_PI / 360;
+    pixels.emplace_back(cx + radius * fx * std::cos(phi),
+                        cy + radius * fy * std::sin(phi));
+  }
+  for (const Eigen::Vector2d& pixel : pixels) {
+    double ray[3];
+    if (Model::RayFromImage(params.data(), pixel.data(), ray) && ray[2] <= 0) {
+      return false;
     }
   }
   return true;
 }
 
-// Images of sizes whose corners reach from well inside to well beyond 90° off
-// the axis (369 to 531 px from the centre) for lenses of focal length ~300 px,
-// each with the principal point near its centre: ImageInFrontOfImagePlane
-// must agree with the scan on each, and both answers must occur.
+// Frames of sizes whose image circles reach from well inside to well beyond
+// 90° off the axis (350 to 550 px about the centre) for lenses of focal
+// length ~300 px, each with the principal point near its centre:
+// FieldInFrontOfImagePlane must agree with the scan on each, and both
+// answers must occur.
 template <typename Model>
-void ExpectImageInFrontMatchesScan(std::vector<double> params) {
+void ExpectFieldInFrontMatchesScan(std::vector<double> params) {
   int in_front = 0;
   int behind = 0;
-  for (int width = 560; width <= 800; width += 12) {
-    for (int height : {480, 640, 700}) {
+  for (int width = 700; width <= 1100; width += 16) {
+    for (int height : {480, 900, 1000}) {
       params[2] = width / 2.0 + 0.3;
       params[3] = height / 2.0 + 0.2;
-      const bool expected = ScannedImageInFront<Model>(params, width, height);
-      EXPECT_EQ(Model::ImageInFrontOfImagePlane(params.data(), width, height),
+      const bool expected = ScannedFieldInFront<Model>(params, width, height);
+      EXPECT_EQ(Model::FieldInFrontOfImagePlane(params.data(), width, height),
                 expected)
           << width << " x " << height;
       (expected ? in_front : behind) += 1;

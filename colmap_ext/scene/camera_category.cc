@@ -16,7 +16,7 @@ UpstreamCategory CategoryInFront(const std::vector<double>& params,
                                  const size_t height) {
   static_assert(static_cast<int>(UpstreamModel::model_id) == Model::kModelId);
   if (params.size() != static_cast<size_t>(Model::kNumParams) ||
-      !Model::ImageInFrontOfImagePlane(params.data(),
+      !Model::FieldInFrontOfImagePlane(params.data(),
                                        static_cast<int>(width),
                                        static_cast<int>(height))) {
     return UpstreamCategory::kNone;

@@ -1,7 +1,8 @@
 // A camera of a whole-field model (OPENCV_FISHEYE, THIN_PRISM_FISHEYE, EUCM)
-// takes upstream's category exactly when its image lies in front of its
-// image plane, and bundle adjustment then builds upstream's own pixel cost for
-// it; past 90° at a corner it stays spherical with the angular cost.
+// takes upstream's category exactly when the image circle its frame shows
+// lies in front of its image plane, and bundle adjustment then builds
+// upstream's own pixel cost for it; with rays past 90° in that circle it
+// stays spherical with the angular cost.
 #include "colmap_ext/scene/camera_category.h"
 
 #include "colmap/estimators/cost_functions/reprojection_error.h"
@@ -34,8 +35,9 @@ Camera MakeCamera(const std::string& model,
   return camera;
 }
 
-// Equidistant f = 300: rays at 90° land 471 px from the centre; the corners
-// of a 640 px square lie 453 px from it, those of a 700 px square 495 px.
+// Equidistant f = 300: rays at 90° land 471 px from the centre; a 640 px
+// square frame shows an image circle of 320 px about it, a 1000 px one of
+// 500 px.
 const std::vector<double> kEquidistant = {300, 300, 0, 0, 0, 0, 0, 0};
 const std::vector<double> kThinPrism = {
     300, 300, 0, 0, 0, 0, 2e-4, -1e-4, 0, 0, 1e-4, 2e-4};
@@ -58,11 +60,11 @@ void ExpectSpherical(const Camera& camera) {
 
 TEST(CameraCategory, WholeFieldModelsTakeUpstreamsCategoryInFront) {
   ExpectPerspective(MakeCamera("OPENCV_FISHEYE", kEquidistant, 640), true);
-  ExpectSpherical(MakeCamera("OPENCV_FISHEYE", kEquidistant, 700));
+  ExpectSpherical(MakeCamera("OPENCV_FISHEYE", kEquidistant, 1000));
   ExpectPerspective(MakeCamera("THIN_PRISM_FISHEYE", kThinPrism, 640), true);
-  ExpectSpherical(MakeCamera("THIN_PRISM_FISHEYE", kThinPrism, 700));
+  ExpectSpherical(MakeCamera("THIN_PRISM_FISHEYE", kThinPrism, 1000));
   ExpectPerspective(MakeCamera("EUCM", kEUCM, 640), false);
-  ExpectSpherical(MakeCamera("EUCM", kEUCM, 700));
+  ExpectSpherical(MakeCamera("EUCM", kEUCM, 1000));
 }
 
 TEST(CameraCategory, OtherCamerasKeepTheirModelsCategory) {
@@ -108,7 +110,7 @@ std::unique_ptr<ceres::CostFunction> CostFor(const Camera& camera,
 
 TEST(CameraCategory, InFrontCameraGetsUpstreamsPixelCost) {
   const Eigen::Vector2d offset(1.5, -2.0);
-  for (const size_t size : {640, 700}) {
+  for (const size_t size : {640, 1000}) {
     const Camera camera = MakeCamera("OPENCV_FISHEYE", kEquidistant, size);
     const Eigen::Vector2d projection(size / 2.0 + 300 * 20 * M_PI / 180,
                                      size / 2.0);
