@@ -19,12 +19,15 @@ set(SPHERA_COLMAP_CONTROLLER_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_bundle_adjustment.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/sphere_undistortion.cc
   ${CMAKE_CURRENT_LIST_DIR}/controllers/strecha_import.cc)
+# The source of colmap_ext/scene/ that the patch series compiles into
+# COLMAP's colmap_scene_types library, beside camera.cc: a camera's category.
+set(SPHERA_COLMAP_SCENE_TYPES_SRCS
+  ${CMAKE_CURRENT_LIST_DIR}/scene/camera_category.cc)
 # Sources of colmap_ext/scene/ that the patch series compiles into COLMAP's
-# colmap_scene library (a camera's category comes from them; the database
-# opens through them and checks its cameras; the mapper, in colmap_sfm above it, checks refined intrinsics
+# colmap_scene library (the database opens through them and checks its
+# cameras; the mapper, in colmap_sfm above it, checks refined intrinsics
 # with them).
 set(SPHERA_COLMAP_SCENE_SRCS
-  ${CMAKE_CURRENT_LIST_DIR}/scene/camera_category.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/camera_params_error.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/database_check.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/intrinsics_divergence.cc
