@@ -669,6 +669,18 @@ def fisheye160_rig():
     return fisheye190_rig("OPENCV_FISHEYE", FISHEYE160_PARAMS)
 
 
+# EUCM lens, 1024x1024: 160 degrees across the same 537 px image circle
+# (alpha 0.6, beta 1: 80 degrees at 1.472 focal lengths); the frame's edges
+# at 512 px lie 76 degrees off the axis.
+EUCM160_PARAMS = [364.8, 364.8, 512, 512, 0.6, 1.0]
+
+
+def eucm160_rig():
+    """The 12 poses of fisheye190_rig with EUCM lenses under 180 degrees,
+    which upstream COLMAP knows too (its EUCM stops at z > 0)."""
+    return fisheye190_rig("EUCM", EUCM160_PARAMS)
+
+
 def hybrid_rig():
     """4 equirect at the grid corners, 4 fisheye at the grid edges, 4 pinhole
     near the centre looking out at the room's corners."""
