@@ -163,7 +163,7 @@ bool ScannedFieldInFront(const std::vector<double>& params, int width,
                          int height) {
   const double fx = params[0], fy = params[1], cx = params[2], cy = params[3];
   const double radius =
-      std::max(std::max(cx, width - cx) / fx, std::max(cy, height - cy) / fy);
+      internal::FrameCircleRadius(params.data(), width, height);
   std::vector<Eigen::Vector2d> pixels;
   for (double px = cx - radius * fx; px <= cx + radius * fx; px += 4) {
     for (double py = cy - radius * fy; py <= cy + radius * fy; py += 4) {

@@ -67,6 +67,51 @@ TEST(CameraCategory, WholeFieldModelsTakeUpstreamsCategoryInFront) {
   ExpectSpherical(MakeCamera("EUCM", kEUCM, 1000));
 }
 
+// Real lenses: the fits of scripts/fit_real_lenses.py to the refined corners
+// of OCamCalib's sample sets (../shared/data/real_cameras/ocamcalib/). The
+// 190° fisheye (752 x 480, its circle cropped at the top and bottom, 98° at
+// the rim) and the paracatadioptric camera stay spherical in either model;
+// the Ladybug lens (41° at its corners) is upstream's camera.
+TEST(CameraCategory, RealLensesFallOnTheRightSide) {
+  const auto camera = [](const std::string& model,
+                         const std::vector<double>& params,
+                         const size_t width,
+                         const size_t height) {
+    Camera c;
+    c.model_id = CameraModelNameToId(model);
+    c.params = params;
+    c.width = width;
+    c.height = height;
+    c.has_prior_focal_length = true;
+    return c;
+  };
+  ExpectSpherical(camera("OPENCV_FISHEYE",
+                         {209.3776, 209.1093, 358.9734, 244.2221, -0.046997,
+                          0.013335, -0.016102, 0.003241},
+                         752,
+                         480));
+  ExpectSpherical(camera(
+      "EUCM", {208.9695, 208.6981, 358.9119, 244.2251, 0.757601, 0.973323},
+      752,
+      480));
+  ExpectPerspective(camera("OPENCV_FISHEYE",
+                           {550.1279, 548.6234, 503.2291, 384.5753, -0.070295,
+                            0.094461, -0.328593, 0.346520},
+                           1024,
+                           768),
+                    true);
+  ExpectPerspective(camera("EUCM",
+                           {550.0430, 548.5562, 503.2243, 384.5174, 0.752360,
+                            1.047576},
+                           1024,
+                           768),
+                    false);
+  ExpectSpherical(camera(
+      "EUCM", {148.6651, 148.8086, 643.6744, 523.1360, 0.529208, 1.009811},
+      1280,
+      1024));
+}
+
 TEST(CameraCategory, OtherCamerasKeepTheirModelsCategory) {
   // The same lens as a camera without an image size, with parameters of the
   // wrong count, and with a focal length the image reader guessed, is the
