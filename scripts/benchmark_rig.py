@@ -32,6 +32,11 @@ Usage (from the repository root, after scripts/build.sh):
   scripts/benchmark_rig.py                        3 seeds, both presets
   scripts/benchmark_rig.py --repeats 1 --presets dual_fisheye --frames 10
   scripts/benchmark_rig.py --first_seed 1 --repeats 2 ...   adds seeds 1, 2
+  scripts/benchmark_rig.py --reuse_database build/bench_rig --output DIR ...
+                                                  maps the databases of an
+                                                  earlier output again (the
+                                                  same options), e.g. with
+                                                  another --colmap
   scripts/benchmark_rig.py --start_focal_scale 1.2 --start_no_distortion ...
                                                   self-calibration: the rig
                                                   starts from focal lengths
@@ -199,8 +204,10 @@ def fitted_rig_config(scene, path, model, half_field_deg):
 
 
 def run_system(scene, preset, system, work, program, num_lenses,
-               start=(1.0, False), fit_model=""):
-    """Reconstructs SCENE with SYSTEM; returns a row of results."""
+               start=(1.0, False), fit_model="", reuse=""):
+    """Reconstructs SCENE with SYSTEM; returns a row of results. REUSE: an
+    earlier run's folder whose database (features, rig, matches) is mapped
+    again instead of extracting and matching."""
     import json
     os.makedirs(work)
     logs = os.path.join(work, "logs")
@@ -210,7 +217,18 @@ def run_system(scene, preset, system, work, program, num_lenses,
     extraction = ["--FeatureExtraction.use_gpu", "0"]
     with open(os.path.join(scene, "rig_config.json")) as f:
         lens0 = json.load(f)[0]["cameras"][0]
-    if system == "rig":
+    if reuse:
+        earlier = os.path.join(reuse, "database.db")
+        if not os.path.exists(earlier):
+            raise RuntimeError(f"no database to reuse at {earlier}")
+        shutil.copyfile(earlier, database)
+        for suffix in ("-wal", "-shm"):  # a database left in WAL mode
+            if os.path.exists(earlier + suffix):
+                shutil.copyfile(earlier + suffix, database + suffix)
+        image_path = os.path.join(scene, "stitched", "images") \
+            if system.startswith("stitched") else os.path.join(scene, "images")
+        t_extract = t_match = 0.0
+    elif system == "rig":
         image_path = os.path.join(scene, "images")
         t_extract = timed(program, [
             "feature_extractor", "--database_path", database, "--image_path",
@@ -250,9 +268,10 @@ def run_system(scene, preset, system, work, program, num_lenses,
             image_path, "--ImageReader.camera_model", "EQUIRECTANGULAR",
             "--ImageReader.single_camera", "1", *extraction],
             os.path.join(logs, "extract.log"))
-    t_match = timed(program, ["exhaustive_matcher", "--database_path",
-                              database, "--FeatureMatching.use_gpu", "0"],
-                    os.path.join(logs, "match.log"))
+    if not reuse:
+        t_match = timed(program, ["exhaustive_matcher", "--database_path",
+                                  database, "--FeatureMatching.use_gpu", "0"],
+                        os.path.join(logs, "match.log"))
     sparse = os.path.join(work, "sparse")
     os.makedirs(sparse)
     t_map = timed(program, ["mapper", "--database_path", database,
@@ -468,6 +487,11 @@ def main():
                         help="rays per pixel side of the renders")
     parser.add_argument("--output", default=os.path.join(REPO, "build",
                                                          "bench_rig"))
+    parser.add_argument("--reuse_database", default="",
+                        help="an earlier --output of the same scenes: each "
+                             "run maps that run's database again (mapping "
+                             "alone; scenes missing here are rendered again "
+                             "for their ground truth)")
     add_program_arguments(parser)
     parser.add_argument("--upstream_colmap", default=common.UPSTREAM_COLMAP)
     parser.add_argument("--no_upstream", action="store_true")
@@ -548,7 +572,10 @@ def main():
                     row = run_system(scene, preset, system, work, program,
                                      num_lenses, (args.start_focal_scale,
                                                   args.start_no_distortion),
-                                     args.fit_model)
+                                     args.fit_model,
+                                     os.path.join(args.reuse_database,
+                                                  os.path.basename(work))
+                                     if args.reuse_database else "")
                 except (RuntimeError, OSError, ValueError) as error:
                     row = {"preset": preset, "system": system,
                            "error": str(error).splitlines()[0]}

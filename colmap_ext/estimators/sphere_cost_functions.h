@@ -10,15 +10,22 @@
 //   theta = atan2(|w|, u . v),
 //
 // so |r| is the geodesic angle between u and v (no image seam, no weight that
-// grows towards the poles, smooth at zero). It is divided by the camera's
-// radians per pixel at the parameters the cost function is made with, so
-// that robust-loss scales and error statistics stay in pixels. That unit is a
-// constant of the cost function: scaled by the radians per pixel of the
-// parameters being refined, the cost would fall with the focal length alone,
-// and derivatives that leave the scale out would not be those of the cost
-// (bundle adjustment then stalls with the trust region collapsing, as a
-// self-calibrated lens did). A problem built again after a solve takes the
-// new unit. Intrinsics enter through u, so they can be refined.
+// grows towards the poles, smooth at zero). It is taken to pixels so that
+// robust-loss scales and error statistics stay in pixels, by the camera's
+// own derivative of the pixel by the tangent plane at u, at the parameters
+// being refined (AngularWeightAt): W r is then the pixel residual to first
+// order, direction included, and stays so while the intrinsics move. A lens
+// compresses its image towards the rim radially unlike tangentially (a
+// 200-degree Kannala-Brandt lens has 1.7 times as many pixels per radian
+// along its rim as on its axis), and the pixels per radian follow the focal
+// length: an angle measures a keypoint's pixel noise only through them. A
+// fixed scale (the camera's pixels per radian on its axis when the problem
+// is built) lets a longer focal length shrink every residual, the noise's
+// included: on a rendered 8-lens rig it leaves the focal lengths 0.02-0.05%
+// long and the lens centres 0.4 to 1.1 mm off, where this metric gives
+// 0.06 to 0.5 mm (docs/rigs.md). EQUIRECTANGULAR keeps one fixed scale: its pixels
+// per radian of longitude grow without bound towards the poles. Intrinsics
+// enter through u and W, so they can be refined.
 //
 // Each functor below has the parameter blocks of the upstream pixel functor
 // of the same name without "Angular" (reprojection_error.h), so that
@@ -43,7 +50,10 @@
 #include "camera_models/equirectangular.h"
 #include "estimators/angular_residual.h"
 
+#include <cmath>
 #include <type_traits>
+
+#include <Eigen/SVD>
 
 namespace colmap {
 
@@ -75,13 +85,129 @@ double AngularPixelsPerRadian(const double* camera_params) {
   }
 }
 
+// How the angular residual of one observation is taken to pixels
+// (AngularResidualWeight): by the camera's own derivative at the observed
+// pixel (AngularWeightAt), or by one scale for every direction, the
+// camera's pixels per radian on its axis at the parameters it was made
+// with.
+struct AngularWeight {
+  bool isotropic = true;
+  double scale = 1;
+};
+
+// The metric of the angular residual of the observation at PIXEL. Only
+// EQUIRECTANGULAR (whose pixels per radian of longitude grow without bound
+// towards the poles), a pixel without a ray, and a derivative stretched
+// beyond a tenth or ten times the camera's pixels per radian on its axis
+// (near a singular point of the model) take the isotropic scale.
+template <typename CameraModel>
+AngularWeight AngularResidualWeight(const double* camera_params,
+                                    const Eigen::Vector2d& pixel) {
+  using SphereModel = typename SphereMathOf<CameraModel>::type;
+  AngularWeight weight;
+  weight.scale = AngularPixelsPerRadian<CameraModel>(camera_params);
+  if constexpr (!std::is_void_v<SphereModel> &&
+                CameraModel::model_id != CameraModelId::kEquirectangular) {
+    constexpr int kNumParams = static_cast<int>(CameraModel::num_params);
+    using Jet = ceres::Jet<double, 2>;
+    Jet params[kNumParams];
+    for (int i = 0; i < kNumParams; ++i) params[i] = Jet(camera_params[i]);
+    const Jet pixel_jet[2] = {Jet(pixel.x(), 0), Jet(pixel.y(), 1)};
+    Jet ray[3];
+    if (!SphereModel::RayFromImage(params, pixel_jet, ray)) {
+      return weight;
+    }
+    const double u[3] = {ray[0].a, ray[1].a, ray[2].a};
+    const double norm = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (!(norm > 0) || !std::isfinite(norm)) {
+      return weight;
+    }
+    double e1[3], e2[3];
+    sphera::RayTangentBasis(u, e1, e2);
+    Eigen::Matrix2d tangent_from_pixel;
+    for (int c = 0; c < 2; ++c) {
+      const double d[3] = {ray[0].v[c], ray[1].v[c], ray[2].v[c]};
+      tangent_from_pixel(0, c) =
+          (e1[0] * d[0] + e1[1] * d[1] + e1[2] * d[2]) / norm;
+      tangent_from_pixel(1, c) =
+          (e2[0] * d[0] + e2[1] * d[1] + e2[2] * d[2]) / norm;
+    }
+    const Eigen::JacobiSVD<Eigen::Matrix2d> svd(tangent_from_pixel);
+    const Eigen::Vector2d radians_per_pixel = svd.singularValues();
+    weight.isotropic = !radians_per_pixel.allFinite() ||
+                       !(radians_per_pixel(1) * 10 * weight.scale > 1) ||
+                       !(radians_per_pixel(0) * weight.scale < 10);
+  }
+  return weight;
+}
+
+// The 2 x 2 map of the log map at OBSERVED_RAY (the ray of OBSERVED_PIXEL,
+// in its RayTangentBasis) to pixels at CAMERA_PARAMS: (d t / d pixel)^-1
+// through the camera as it now is, so that W r is the pixel residual to
+// first order at every value of the parameters being refined (see the
+// header comment), or WEIGHT's one scale where AngularResidualWeight found
+// none. The derivative is a forward difference over kAngularWeightStep
+// pixels (relative error about the step over the focal length); with T a
+// Jet it carries the metric's own derivatives by the parameters.
+constexpr double kAngularWeightStep = 0.05;
+
+template <typename CameraModel, typename T>
+Eigen::Matrix<T, 2, 2> AngularWeightAt(const AngularWeight& weight,
+                                       const T* camera_params,
+                                       const Eigen::Vector2d& observed_pixel,
+                                       const T* observed_ray) {
+  using SphereModel = typename SphereMathOf<CameraModel>::type;
+  Eigen::Matrix<T, 2, 2> isotropic;
+  isotropic << T(weight.scale), T(0), T(0), T(weight.scale);
+  if constexpr (std::is_void_v<SphereModel> ||
+                CameraModel::model_id == CameraModelId::kEquirectangular) {
+    return isotropic;
+  } else {
+    if (weight.isotropic) {
+      return isotropic;
+    }
+    using std::sqrt;
+    const T norm = sqrt(observed_ray[0] * observed_ray[0] +
+                        observed_ray[1] * observed_ray[1] +
+                        observed_ray[2] * observed_ray[2]);
+    T e1[3], e2[3];
+    sphera::RayTangentBasis(observed_ray, e1, e2);
+    T m[2][2];
+    for (int c = 0; c < 2; ++c) {
+      const T pixel[2] = {
+          T(observed_pixel.x() + (c == 0 ? kAngularWeightStep : 0.0)),
+          T(observed_pixel.y() + (c == 1 ? kAngularWeightStep : 0.0))};
+      T ray[3];
+      if (!SphereModel::RayFromImage(camera_params, pixel, ray)) {
+        return isotropic;
+      }
+      const T ray_norm =
+          sqrt(ray[0] * ray[0] + ray[1] * ray[1] + ray[2] * ray[2]);
+      T d[3];
+      for (int k = 0; k < 3; ++k) {
+        d[k] = (ray[k] / ray_norm - observed_ray[k] / norm) /
+               T(kAngularWeightStep);
+      }
+      m[0][c] = e1[0] * d[0] + e1[1] * d[1] + e1[2] * d[2];
+      m[1][c] = e2[0] * d[0] + e2[1] * d[1] + e2[2] * d[2];
+    }
+    const T det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    if (!(det > T(0)) && !(det < T(0))) {
+      return isotropic;
+    }
+    Eigen::Matrix<T, 2, 2> w;
+    w << m[1][1] / det, -m[0][1] / det, -m[1][0] / det, m[0][0] / det;
+    return w;
+  }
+}
+
 // The residual of one observation: the one body behind every functor below,
-// in units of 1 / PIXELS_PER_RADIAN radians.
+// the log map taken to pixels by WEIGHT (AngularResidualWeight).
 template <typename CameraModel, typename T>
 bool AngularReprojResidual(const T* camera_params,
                            const Eigen::Vector2d& observed_pixel,
                            const Eigen::Matrix<T, 3, 1>& point3D_in_cam,
-                           const double pixels_per_radian,
+                           const AngularWeight& weight,
                            T* residuals) {
   using SphereModel = typename SphereMathOf<CameraModel>::type;
   if constexpr (std::is_void_v<SphereModel>) {
@@ -92,9 +218,14 @@ bool AngularReprojResidual(const T* camera_params,
     if (!SphereModel::RayFromImage(camera_params, pixel, observed_ray)) {
       return false;
     }
-    sphera::AngularLogResidual(observed_ray, point3D_in_cam.data(), residuals);
-    residuals[0] *= T(pixels_per_radian);
-    residuals[1] *= T(pixels_per_radian);
+    Eigen::Matrix<T, 2, 1> log_map;
+    sphera::AngularLogResidual(
+        observed_ray, point3D_in_cam.data(), log_map.data());
+    Eigen::Map<Eigen::Matrix<T, 2, 1>> residual_map(residuals);
+    residual_map =
+        AngularWeightAt<CameraModel>(
+            weight, camera_params, observed_pixel, observed_ray) *
+        log_map;
     return true;
   }
 }
@@ -108,7 +239,7 @@ template <typename CameraModel>
 bool AngularReprojResidualWithJacobians(const double* camera_params,
                                         const Eigen::Vector2d& observed_pixel,
                                         const double* point3D_in_cam,
-                                        const double pixels_per_radian,
+                                        const AngularWeight& weight,
                                         double* residuals,
                                         double* J_point_in_cam,
                                         double* J_params) {
@@ -123,12 +254,22 @@ bool AngularReprojResidualWithJacobians(const double* camera_params,
       if (!SphereModel::RayFromImage(camera_params, pixel, observed_ray)) {
         return false;
       }
+      Eigen::Vector2d log_map;
+      Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J_log_map;
       sphera::AngularLogResidualWithJacobian(
-          observed_ray, point3D_in_cam, residuals, J_point_in_cam);
-      residuals[0] *= pixels_per_radian;
-      residuals[1] *= pixels_per_radian;
+          observed_ray,
+          point3D_in_cam,
+          log_map.data(),
+          J_point_in_cam != nullptr ? J_log_map.data() : nullptr);
+      const Eigen::Matrix2d w =
+          AngularWeightAt<CameraModel>(
+              weight, camera_params, observed_pixel, observed_ray);
+      Eigen::Map<Eigen::Vector2d> residual_map(residuals);
+      residual_map = w * log_map;
       if (J_point_in_cam != nullptr) {
-        for (int i = 0; i < 6; ++i) J_point_in_cam[i] *= pixels_per_radian;
+        Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> J_map(
+            J_point_in_cam);
+        J_map = w * J_log_map;
       }
       return true;
     }
@@ -146,18 +287,20 @@ bool AngularReprojResidualWithJacobians(const double* camera_params,
     const Jet point[3] = {Jet(point3D_in_cam[0], kNumParams),
                           Jet(point3D_in_cam[1], kNumParams + 1),
                           Jet(point3D_in_cam[2], kNumParams + 2)};
-    Jet residual[2];
-    sphera::AngularLogResidual(observed_ray, point, residual);
+    Eigen::Matrix<Jet, 2, 1> log_map;
+    sphera::AngularLogResidual(observed_ray, point, log_map.data());
+    const Eigen::Matrix<Jet, 2, 1> residual =
+        AngularWeightAt<CameraModel>(
+            weight, params, observed_pixel, observed_ray) *
+        log_map;
     for (int row = 0; row < 2; ++row) {
-      residuals[row] = residual[row].a * pixels_per_radian;
+      residuals[row] = residual(row).a;
       for (int i = 0; i < kNumParams; ++i) {
-        J_params[row * kNumParams + i] =
-            residual[row].v[i] * pixels_per_radian;
+        J_params[row * kNumParams + i] = residual(row).v[i];
       }
       if (J_point_in_cam != nullptr) {
         for (int k = 0; k < 3; ++k) {
-          J_point_in_cam[row * 3 + k] =
-              residual[row].v[kNumParams + k] * pixels_per_radian;
+          J_point_in_cam[row * 3 + k] = residual(row).v[kNumParams + k];
         }
       }
     }
@@ -176,7 +319,7 @@ class AngularReprojErrorCostFunction
   AngularReprojErrorCostFunction(const double* camera_params,
                                  const Eigen::Vector2d& point2D)
       : point2D_(point2D),
-        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)) {}
+        weight_(AngularResidualWeight<CameraModel>(camera_params, point2D)) {}
 
   static ceres::CostFunction* Create(const double* camera_params,
                                      const Eigen::Vector2d& point2D) {
@@ -203,7 +346,7 @@ class AngularReprojErrorCostFunction
             parameters[2],
             point2D_,
             point3D_in_cam.data(),
-            pixels_per_radian_,
+            weight_,
             residuals,
             (J_point || J_pose) ? J_in_cam.data() : nullptr,
             J_params)) {
@@ -227,7 +370,7 @@ class AngularReprojErrorCostFunction
 
  private:
   const Eigen::Vector2d point2D_;
-  const double pixels_per_radian_;
+  const AngularWeight weight_;
 };
 
 // The same with a constant pose (upstream's
@@ -240,7 +383,7 @@ class AngularReprojErrorConstantPoseCostFunction
                                              const Eigen::Vector2d& point2D,
                                              const Rigid3d& cam_from_world)
       : point2D_(point2D),
-        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)),
+        weight_(AngularResidualWeight<CameraModel>(camera_params, point2D)),
         cam_from_world_rotation_(cam_from_world.rotation().toRotationMatrix()),
         cam_from_world_translation_(cam_from_world.translation()) {}
 
@@ -265,7 +408,7 @@ class AngularReprojErrorConstantPoseCostFunction
             parameters[1],
             point2D_,
             point3D_in_cam.data(),
-            pixels_per_radian_,
+            weight_,
             residuals,
             J_point ? J_in_cam.data() : nullptr,
             J_params)) {
@@ -281,7 +424,7 @@ class AngularReprojErrorConstantPoseCostFunction
 
  private:
   const Eigen::Vector2d point2D_;
-  const double pixels_per_radian_;
+  const AngularWeight weight_;
   const Eigen::Matrix3d cam_from_world_rotation_;
   const Eigen::Vector3d cam_from_world_translation_;
 };
@@ -297,7 +440,7 @@ class AngularReprojErrorCostFunctor
   AngularReprojErrorCostFunctor(const double* camera_params,
                                 const Eigen::Vector2d& point2D)
       : point2D_(point2D),
-        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)) {}
+        weight_(AngularResidualWeight<CameraModel>(camera_params, point2D)) {}
 
   template <typename T>
   bool operator()(const T* const point3D_in_world,
@@ -309,12 +452,12 @@ class AngularReprojErrorCostFunctor
             EigenVector3Map<T>(point3D_in_world) +
         EigenVector3Map<T>(cam_from_world + 4);
     return AngularReprojResidual<CameraModel>(
-        camera_params, point2D_, point3D_in_cam, pixels_per_radian_, residuals);
+        camera_params, point2D_, point3D_in_cam, weight_, residuals);
   }
 
  private:
   const Eigen::Vector2d point2D_;
-  const double pixels_per_radian_;
+  const AngularWeight weight_;
 };
 
 template <typename CameraModel>
@@ -352,7 +495,7 @@ class AngularReprojErrorConstantPoint3DCostFunctor
 // constant cam_from_rig passes none for it).
 template <typename CameraModel>
 bool AngularRigResidualWithJacobians(const Eigen::Vector2d& point2D,
-                                     const double pixels_per_radian,
+                                     const AngularWeight& weight,
                                      const double* point3D_in_world,
                                      const double* cam_from_rig,
                                      const double* rig_from_world,
@@ -382,7 +525,7 @@ bool AngularRigResidualWithJacobians(const Eigen::Vector2d& point2D,
           camera_params,
           point2D,
           point3D_in_cam.data(),
-          pixels_per_radian,
+          weight,
           residuals,
           geometry ? J_in_cam.data() : nullptr,
           J_params)) {
@@ -424,7 +567,7 @@ class AngularRigReprojErrorCostFunction
   AngularRigReprojErrorCostFunction(const double* camera_params,
                                     const Eigen::Vector2d& point2D)
       : point2D_(point2D),
-        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)) {}
+        weight_(AngularResidualWeight<CameraModel>(camera_params, point2D)) {}
 
   static ceres::CostFunction* Create(const double* camera_params,
                                      const Eigen::Vector2d& point2D) {
@@ -436,7 +579,7 @@ class AngularRigReprojErrorCostFunction
                 double** jacobians) const override {
     return AngularRigResidualWithJacobians<CameraModel>(
         point2D_,
-        pixels_per_radian_,
+        weight_,
         parameters[0],
         parameters[1],
         parameters[2],
@@ -450,7 +593,7 @@ class AngularRigReprojErrorCostFunction
 
  private:
   const Eigen::Vector2d point2D_;
-  const double pixels_per_radian_;
+  const AngularWeight weight_;
 };
 
 // The same with a constant cam_from_rig (upstream's
@@ -463,7 +606,7 @@ class AngularRigReprojErrorConstantRigCostFunction
                                                const Eigen::Vector2d& point2D,
                                                const Rigid3d& cam_from_rig)
       : point2D_(point2D),
-        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)),
+        weight_(AngularResidualWeight<CameraModel>(camera_params, point2D)),
         cam_from_rig_(cam_from_rig.params) {}
 
   static ceres::CostFunction* Create(const double* camera_params,
@@ -478,7 +621,7 @@ class AngularRigReprojErrorConstantRigCostFunction
                 double** jacobians) const override {
     return AngularRigResidualWithJacobians<CameraModel>(
         point2D_,
-        pixels_per_radian_,
+        weight_,
         parameters[0],
         cam_from_rig_.data(),
         parameters[1],
@@ -492,7 +635,7 @@ class AngularRigReprojErrorConstantRigCostFunction
 
  private:
   const Eigen::Vector2d point2D_;
-  const double pixels_per_radian_;
+  const AngularWeight weight_;
   const Eigen::Matrix<double, 7, 1> cam_from_rig_;
 };
 

@@ -39,7 +39,7 @@ class AngularRigReprojErrorCostFunctor
   AngularRigReprojErrorCostFunctor(const double* camera_params,
                                    const Eigen::Vector2d& point2D)
       : point2D_(point2D),
-        pixels_per_radian_(AngularPixelsPerRadian<CameraModel>(camera_params)) {}
+        weight_(AngularResidualWeight<CameraModel>(camera_params, point2D)) {}
 
   template <typename T>
   bool operator()(const T* const point3D_in_world,
@@ -54,12 +54,12 @@ class AngularRigReprojErrorCostFunctor
              EigenVector3Map<T>(rig_from_world + 4)) +
         EigenVector3Map<T>(cam_from_rig + 4);
     return AngularReprojResidual<CameraModel>(
-        camera_params, point2D_, point3D_in_cam, pixels_per_radian_, residuals);
+        camera_params, point2D_, point3D_in_cam, weight_, residuals);
   }
 
  private:
   const Eigen::Vector2d point2D_;
-  const double pixels_per_radian_;
+  const AngularWeight weight_;
 };
 
 struct CostCase {
@@ -78,6 +78,11 @@ std::vector<CostCase> CostCases() {
        1000,
        800},
       {"DOUBLE_SPHERE", {300, 310, 500, 400, -0.2, 0.6}, 1000, 800},
+      // Kannala-Brandt over its whole field (no focal prior: spherical).
+      {"OPENCV_FISHEYE",
+       {300, 305, 500, 400, -0.012, 0.0016, -0.0002, 0.00001},
+       1000,
+       800},
   };
 }
 
@@ -402,6 +407,110 @@ TEST_P(SphereCostFunction, ParamsJacobianIsTheDerivativeOfTheCost) {
   // Most observations are off their point by a fraction of a degree: the
   // residual's unit would change their residual with the focal length.
   EXPECT_GT(num_with_error, 30);
+}
+
+// A direction ANGLE off the unit ray U, towards a random side.
+Eigen::Vector3d OffTheRay(const Eigen::Vector3d& u,
+                          double angle,
+                          std::mt19937* rng) {
+  Eigen::Vector3d e1, e2;
+  sphera::RayTangentBasis(u, &e1, &e2);
+  const double phi = std::uniform_real_distribution<double>(-kPi, kPi)(*rng);
+  return std::cos(angle) * u +
+         std::sin(angle) * (std::cos(phi) * e1 + std::sin(phi) * e2);
+}
+
+// The residual of COST (a single-image cost) for the point V seen from the
+// origin through a camera of PARAMS.
+Eigen::Vector2d ResidualAt(const ceres::CostFunction& cost,
+                           const Eigen::Vector3d& v,
+                           const std::vector<double>& params) {
+  const Rigid3d cam_from_world;
+  const Evaluation evaluation =
+      Evaluate(cost, {v.data(), cam_from_world.params.data(), params.data()},
+               0);
+  EXPECT_TRUE(evaluation.ok);
+  return Eigen::Vector2d(evaluation.residuals[0], evaluation.residuals[1]);
+}
+
+// The residual is the pixel residual to first order, direction included: a
+// point a small angle off the observed ray gives the offset of its
+// projection from the observed pixel, wherever the pixel lies (the rims
+// compress the image radially unlike tangentially). EQUIRECTANGULAR is
+// isotropic: the angle times its pixels per radian.
+TEST_P(SphereCostFunction, ResidualIsThePixelOffsetToFirstOrder) {
+  const Camera camera = MakeCamera();
+  std::mt19937 rng(29);
+  const bool isotropic = camera.model_id == CameraModelId::kEquirectangular;
+  const double pixels_per_radian = 1.0 / camera.CamFromImgThreshold(1.0);
+  constexpr double kAngle = 2e-4;
+  int num_anisotropic = 0;
+  for (const auto& observation : Observations(camera, Rigid3d(), &rng)) {
+    // The observed ray (the camera is at the origin), and a point off it.
+    const Eigen::Vector3d u = observation.point3D.normalized();
+    const Eigen::Vector3d v = OffTheRay(u, kAngle, &rng);
+    const std::optional<Eigen::Vector2d> observed =
+        camera.ImgFromCam(u, /*check_cheirality=*/false);
+    const std::optional<Eigen::Vector2d> moved =
+        camera.ImgFromCam(v, /*check_cheirality=*/false);
+    ASSERT_TRUE(observed.has_value() && moved.has_value());
+    std::unique_ptr<ceres::CostFunction> cost(
+        CreateSphereCameraCostFunction<ReprojErrorCostFunctor>(
+            SphereResidualType::ANGULAR, camera, *observed));
+    const Eigen::Vector2d residual = ResidualAt(*cost, v, camera.params);
+    if (isotropic) {
+      EXPECT_NEAR(residual.norm(), kAngle * pixels_per_radian,
+                  1e-6 * pixels_per_radian);
+      continue;
+    }
+    const Eigen::Vector2d offset = *moved - *observed;
+    EXPECT_LT((residual - offset).norm(), 2e-3 * offset.norm())
+        << "pixel " << observed->transpose() << " residual "
+        << residual.transpose() << " offset " << offset.transpose();
+    num_anisotropic += std::abs(residual.norm() / (kAngle * pixels_per_radian) -
+                                1) > 0.05;
+  }
+  // Away from the axis the pixels per radian differ from the axis's.
+  if (!isotropic) {
+    EXPECT_GT(num_anisotropic, 10);
+  }
+}
+
+// The metric follows the focal length being refined: made at one focal
+// length and evaluated at one 5% longer, the residual is still the pixel
+// offset through the camera as it now is (a fixed metric would be 5% short
+// and let a longer focal length shrink every residual).
+TEST_P(SphereCostFunction, ResidualFollowsTheFocalLength) {
+  const Camera camera = MakeCamera();
+  if (camera.model_id == CameraModelId::kEquirectangular) {
+    return;  // no focal length
+  }
+  Camera longer = camera;
+  for (const size_t idx : camera.FocalLengthIdxs()) {
+    longer.params[idx] *= 1.05;
+  }
+  std::mt19937 rng(31);
+  constexpr double kAngle = 2e-4;
+  for (const auto& observation : Observations(camera, Rigid3d(), &rng)) {
+    const std::optional<Eigen::Vector2d> pixel =
+        camera.ImgFromCam(observation.point3D, /*check_cheirality=*/false);
+    ASSERT_TRUE(pixel.has_value());
+    std::unique_ptr<ceres::CostFunction> cost(
+        CreateSphereCameraCostFunction<ReprojErrorCostFunctor>(
+            SphereResidualType::ANGULAR, camera, *pixel));
+    // The pixel's ray through the longer lens, and a point off it.
+    const std::optional<Eigen::Vector3d> ray = longer.CamRayFromImg(*pixel);
+    if (!ray) continue;
+    const Eigen::Vector3d v = OffTheRay(ray->normalized(), kAngle, &rng);
+    const std::optional<Eigen::Vector2d> moved =
+        longer.ImgFromCam(v, /*check_cheirality=*/false);
+    ASSERT_TRUE(moved.has_value());
+    const Eigen::Vector2d residual = ResidualAt(*cost, v, longer.params);
+    const Eigen::Vector2d offset = *moved - *pixel;
+    EXPECT_LT((residual - offset).norm(), 0.02 * offset.norm())
+        << "pixel " << pixel->transpose() << " residual "
+        << residual.transpose() << " offset " << offset.transpose();
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(SphereModels,
