@@ -141,20 +141,20 @@ AngularWeight AngularResidualWeight(const double* camera_params,
   return weight;
 }
 
-// The 2 x 2 map of the log map at OBSERVED_RAY (the ray of OBSERVED_PIXEL,
-// in its RayTangentBasis) to pixels at CAMERA_PARAMS: (d t / d pixel)^-1
-// through the camera as it now is, so that W r is the pixel residual to
-// first order at every value of the parameters being refined (see the
-// header comment), or WEIGHT's one scale where AngularResidualWeight found
-// none. The derivative is a forward difference over kAngularWeightStep
-// pixels (relative error about the step over the focal length); with T a
-// Jet it carries the metric's own derivatives by the parameters.
-constexpr double kAngularWeightStep = 0.05;
+// The 2 x 2 map of the log map at OBSERVED_RAY (in its RayTangentBasis) to
+// pixels at CAMERA_PARAMS: the camera's derivative of the pixel along the
+// tangent plane at the ray, as the camera now is, so that W r is the pixel
+// residual to first order at every value of the parameters being refined
+// (see the header comment), or WEIGHT's one scale where
+// AngularResidualWeight found none. The derivative is a difference of
+// projections (closed forms, where lifting a pixel may take a Newton
+// solve) over kAngularWeightStep radians (relative error about that step);
+// with T a Jet it carries the metric's own derivatives by the parameters.
+constexpr double kAngularWeightStep = 1e-4;
 
 template <typename CameraModel, typename T>
 Eigen::Matrix<T, 2, 2> AngularWeightAt(const AngularWeight& weight,
                                        const T* camera_params,
-                                       const Eigen::Vector2d& observed_pixel,
                                        const T* observed_ray) {
   using SphereModel = typename SphereMathOf<CameraModel>::type;
   Eigen::Matrix<T, 2, 2> isotropic;
@@ -166,37 +166,32 @@ Eigen::Matrix<T, 2, 2> AngularWeightAt(const AngularWeight& weight,
     if (weight.isotropic) {
       return isotropic;
     }
-    using std::sqrt;
-    const T norm = sqrt(observed_ray[0] * observed_ray[0] +
-                        observed_ray[1] * observed_ray[1] +
-                        observed_ray[2] * observed_ray[2]);
-    T e1[3], e2[3];
-    sphera::RayTangentBasis(observed_ray, e1, e2);
-    T m[2][2];
-    for (int c = 0; c < 2; ++c) {
-      const T pixel[2] = {
-          T(observed_pixel.x() + (c == 0 ? kAngularWeightStep : 0.0)),
-          T(observed_pixel.y() + (c == 1 ? kAngularWeightStep : 0.0))};
-      T ray[3];
-      if (!SphereModel::RayFromImage(camera_params, pixel, ray)) {
-        return isotropic;
-      }
-      const T ray_norm =
-          sqrt(ray[0] * ray[0] + ray[1] * ray[1] + ray[2] * ray[2]);
-      T d[3];
-      for (int k = 0; k < 3; ++k) {
-        d[k] = (ray[k] / ray_norm - observed_ray[k] / norm) /
-               T(kAngularWeightStep);
-      }
-      m[0][c] = e1[0] * d[0] + e1[1] * d[1] + e1[2] * d[2];
-      m[1][c] = e2[0] * d[0] + e2[1] * d[1] + e2[2] * d[2];
-    }
-    const T det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-    if (!(det > T(0)) && !(det < T(0))) {
+    T e[2][3];
+    sphera::RayTangentBasis(observed_ray, e[0], e[1]);
+    T centre[2];
+    if (!SphereModel::ImageFromRay(camera_params, observed_ray, centre)) {
       return isotropic;
     }
     Eigen::Matrix<T, 2, 2> w;
-    w << m[1][1] / det, -m[0][1] / det, -m[1][0] / det, m[0][0] / det;
+    for (int c = 0; c < 2; ++c) {
+      // Forwards, or backwards where the step leaves the lens's field.
+      bool projected = false;
+      for (const double step : {kAngularWeightStep, -kAngularWeightStep}) {
+        const T moved_ray[3] = {observed_ray[0] + T(step) * e[c][0],
+                                observed_ray[1] + T(step) * e[c][1],
+                                observed_ray[2] + T(step) * e[c][2]};
+        T moved[2];
+        if (SphereModel::ImageFromRay(camera_params, moved_ray, moved)) {
+          w(0, c) = (moved[0] - centre[0]) / T(step);
+          w(1, c) = (moved[1] - centre[1]) / T(step);
+          projected = true;
+          break;
+        }
+      }
+      if (!projected) {
+        return isotropic;
+      }
+    }
     return w;
   }
 }
@@ -223,8 +218,7 @@ bool AngularReprojResidual(const T* camera_params,
         observed_ray, point3D_in_cam.data(), log_map.data());
     Eigen::Map<Eigen::Matrix<T, 2, 1>> residual_map(residuals);
     residual_map =
-        AngularWeightAt<CameraModel>(
-            weight, camera_params, observed_pixel, observed_ray) *
+        AngularWeightAt<CameraModel>(weight, camera_params, observed_ray) *
         log_map;
     return true;
   }
@@ -262,8 +256,7 @@ bool AngularReprojResidualWithJacobians(const double* camera_params,
           log_map.data(),
           J_point_in_cam != nullptr ? J_log_map.data() : nullptr);
       const Eigen::Matrix2d w =
-          AngularWeightAt<CameraModel>(
-              weight, camera_params, observed_pixel, observed_ray);
+          AngularWeightAt<CameraModel>(weight, camera_params, observed_ray);
       Eigen::Map<Eigen::Vector2d> residual_map(residuals);
       residual_map = w * log_map;
       if (J_point_in_cam != nullptr) {
@@ -290,8 +283,7 @@ bool AngularReprojResidualWithJacobians(const double* camera_params,
     Eigen::Matrix<Jet, 2, 1> log_map;
     sphera::AngularLogResidual(observed_ray, point, log_map.data());
     const Eigen::Matrix<Jet, 2, 1> residual =
-        AngularWeightAt<CameraModel>(
-            weight, params, observed_pixel, observed_ray) *
+        AngularWeightAt<CameraModel>(weight, params, observed_ray) *
         log_map;
     for (int row = 0; row < 2; ++row) {
       residuals[row] = residual(row).a;
