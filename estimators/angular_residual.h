@@ -217,4 +217,37 @@ class AngularReprojectionConstantPoseCost {
   Eigen::Vector3d b_;
 };
 
+// The pixels of a camera along the tangent plane at its ray U: the 2 x 2
+// matrix W (row-major) whose column c is d pixel / d t_c, t the coordinates
+// in RayTangentBasis(U), so that W times the log map at U is, to first
+// order, the pixel offset of the mapped direction. Model is a camera_models/
+// model (ImageFromRay); a difference of projections over STEP radians,
+// forwards or, where that leaves the lens's field, backwards (relative
+// error about STEP); with T a Jet, W carries its derivatives by PARAMS and
+// U. False when a projection fails.
+template <typename Model, typename T>
+bool PixelFromTangentAtRay(const T* params, const T* u, T* w,
+                           double step = 1e-4) {
+  T e[2][3];
+  RayTangentBasis(u, e[0], e[1]);
+  T centre[2];
+  if (!Model::ImageFromRay(params, u, centre)) return false;
+  for (int c = 0; c < 2; ++c) {
+    bool projected = false;
+    for (const double h : {step, -step}) {
+      const T moved_ray[3] = {u[0] + T(h) * e[c][0], u[1] + T(h) * e[c][1],
+                              u[2] + T(h) * e[c][2]};
+      T moved[2];
+      if (Model::ImageFromRay(params, moved_ray, moved)) {
+        w[c] = (moved[0] - centre[0]) / T(h);
+        w[2 + c] = (moved[1] - centre[1]) / T(h);
+        projected = true;
+        break;
+      }
+    }
+    if (!projected) return false;
+  }
+  return true;
+}
+
 }  // namespace sphera

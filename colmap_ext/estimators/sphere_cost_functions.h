@@ -97,9 +97,9 @@ struct AngularWeight {
 
 // The metric of the angular residual of the observation at PIXEL. Only
 // EQUIRECTANGULAR (whose pixels per radian of longitude grow without bound
-// towards the poles), a pixel without a ray, and a derivative stretched
-// beyond a tenth or ten times the camera's pixels per radian on its axis
-// (near a singular point of the model) take the isotropic scale.
+// towards the poles), a pixel without a ray or projection, and pixels per
+// radian beyond a tenth or ten times the camera's on its axis (near a
+// singular point of the model) take the isotropic scale.
 template <typename CameraModel>
 AngularWeight AngularResidualWeight(const double* camera_params,
                                     const Eigen::Vector2d& pixel) {
@@ -108,50 +108,30 @@ AngularWeight AngularResidualWeight(const double* camera_params,
   weight.scale = AngularPixelsPerRadian<CameraModel>(camera_params);
   if constexpr (!std::is_void_v<SphereModel> &&
                 CameraModel::model_id != CameraModelId::kEquirectangular) {
-    constexpr int kNumParams = static_cast<int>(CameraModel::num_params);
-    using Jet = ceres::Jet<double, 2>;
-    Jet params[kNumParams];
-    for (int i = 0; i < kNumParams; ++i) params[i] = Jet(camera_params[i]);
-    const Jet pixel_jet[2] = {Jet(pixel.x(), 0), Jet(pixel.y(), 1)};
-    Jet ray[3];
-    if (!SphereModel::RayFromImage(params, pixel_jet, ray)) {
+    const double pixel_xy[2] = {pixel.x(), pixel.y()};
+    double ray[3];
+    Eigen::Matrix<double, 2, 2, Eigen::RowMajor> w;
+    if (!SphereModel::RayFromImage(camera_params, pixel_xy, ray) ||
+        !sphera::PixelFromTangentAtRay<SphereModel>(
+            camera_params, ray, w.data())) {
       return weight;
     }
-    const double u[3] = {ray[0].a, ray[1].a, ray[2].a};
-    const double norm = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-    if (!(norm > 0) || !std::isfinite(norm)) {
-      return weight;
-    }
-    double e1[3], e2[3];
-    sphera::RayTangentBasis(u, e1, e2);
-    Eigen::Matrix2d tangent_from_pixel;
-    for (int c = 0; c < 2; ++c) {
-      const double d[3] = {ray[0].v[c], ray[1].v[c], ray[2].v[c]};
-      tangent_from_pixel(0, c) =
-          (e1[0] * d[0] + e1[1] * d[1] + e1[2] * d[2]) / norm;
-      tangent_from_pixel(1, c) =
-          (e2[0] * d[0] + e2[1] * d[1] + e2[2] * d[2]) / norm;
-    }
-    const Eigen::JacobiSVD<Eigen::Matrix2d> svd(tangent_from_pixel);
-    const Eigen::Vector2d radians_per_pixel = svd.singularValues();
-    weight.isotropic = !radians_per_pixel.allFinite() ||
-                       !(radians_per_pixel(1) * 10 * weight.scale > 1) ||
-                       !(radians_per_pixel(0) * weight.scale < 10);
+    const Eigen::Vector2d pixels_per_radian =
+        Eigen::JacobiSVD<Eigen::Matrix2d>(w).singularValues();
+    weight.isotropic = !pixels_per_radian.allFinite() ||
+                       !(pixels_per_radian(0) < 10 * weight.scale) ||
+                       !(pixels_per_radian(1) * 10 > weight.scale);
   }
   return weight;
 }
 
 // The 2 x 2 map of the log map at OBSERVED_RAY (in its RayTangentBasis) to
-// pixels at CAMERA_PARAMS: the camera's derivative of the pixel along the
-// tangent plane at the ray, as the camera now is, so that W r is the pixel
-// residual to first order at every value of the parameters being refined
-// (see the header comment), or WEIGHT's one scale where
-// AngularResidualWeight found none. The derivative is a difference of
-// projections (closed forms, where lifting a pixel may take a Newton
-// solve) over kAngularWeightStep radians (relative error about that step);
-// with T a Jet it carries the metric's own derivatives by the parameters.
-constexpr double kAngularWeightStep = 1e-4;
-
+// pixels at CAMERA_PARAMS: the camera's pixels along the tangent plane at
+// the ray as the camera now is (sphera::PixelFromTangentAtRay), so that W r
+// is the pixel residual to first order at every value of the parameters
+// being refined (see the header comment); with T a Jet it carries the
+// metric's own derivatives by the parameters. WEIGHT's one scale where
+// AngularResidualWeight found none or the projection fails.
 template <typename CameraModel, typename T>
 Eigen::Matrix<T, 2, 2> AngularWeightAt(const AngularWeight& weight,
                                        const T* camera_params,
@@ -163,34 +143,11 @@ Eigen::Matrix<T, 2, 2> AngularWeightAt(const AngularWeight& weight,
                 CameraModel::model_id == CameraModelId::kEquirectangular) {
     return isotropic;
   } else {
-    if (weight.isotropic) {
+    Eigen::Matrix<T, 2, 2, Eigen::RowMajor> w;
+    if (weight.isotropic ||
+        !sphera::PixelFromTangentAtRay<SphereModel>(
+            camera_params, observed_ray, w.data())) {
       return isotropic;
-    }
-    T e[2][3];
-    sphera::RayTangentBasis(observed_ray, e[0], e[1]);
-    T centre[2];
-    if (!SphereModel::ImageFromRay(camera_params, observed_ray, centre)) {
-      return isotropic;
-    }
-    Eigen::Matrix<T, 2, 2> w;
-    for (int c = 0; c < 2; ++c) {
-      // Forwards, or backwards where the step leaves the lens's field.
-      bool projected = false;
-      for (const double step : {kAngularWeightStep, -kAngularWeightStep}) {
-        const T moved_ray[3] = {observed_ray[0] + T(step) * e[c][0],
-                                observed_ray[1] + T(step) * e[c][1],
-                                observed_ray[2] + T(step) * e[c][2]};
-        T moved[2];
-        if (SphereModel::ImageFromRay(camera_params, moved_ray, moved)) {
-          w(0, c) = (moved[0] - centre[0]) / T(step);
-          w(1, c) = (moved[1] - centre[1]) / T(step);
-          projected = true;
-          break;
-        }
-      }
-      if (!projected) {
-        return isotropic;
-      }
     }
     return w;
   }
