@@ -28,6 +28,7 @@ Data sets (rows):
                      with the renderer's --realistic sensor effects (cropped
                      image circle, vignetting, flare, exposure, noise, JPEG)
   room_eucm160       the same with EUCM 160-degree lenses
+  room_thinprism160  the same with THIN_PRISM_FISHEYE 160-degree lenses
   room_hybrid        4 equirect + 4 fisheye + 4 PINHOLE 800x600
   room_poles         9 equirectangular 2048x1024, alternately near floor and
                      ceiling: many features near the poles
@@ -40,9 +41,10 @@ Programs: SPHERA build/bin/colmap and build/synthetic/sphera_render, output
 build/bench. Reference "upstream": unpatched upstream COLMAP 4.x at the same
 commit (--upstream_colmap, default ~/.cache/sphera-peers/colmap4/build/src/
 colmap/exe/colmap, built with ../shared/peers/build_colmap4.sh when missing,
-about 40 minutes). It knows EQUIRECTANGULAR, PINHOLE, OPENCV_FISHEYE and EUCM
-(within their hemisphere), so it runs on room9_equirect, room_fisheye160,
-room_eucm160, room_poles, room_pinhole_ring, the Strecha sets and equirect_flat; the
+about 40 minutes). It knows EQUIRECTANGULAR, PINHOLE, OPENCV_FISHEYE,
+THIN_PRISM_FISHEYE and EUCM (within their hemisphere), so it runs on
+room9_equirect, room_fisheye160, room_eucm160, room_thinprism160,
+room_poles, room_pinhole_ring, the Strecha sets and equirect_flat; the
 190-degree fisheye and hybrid sets get an upstream row "cannot:
 camera model UNIFIED_OMNI unknown to upstream". Both systems get the same
 command line (--FeatureExtraction.*, --FeatureMatching.*).
@@ -129,7 +131,7 @@ import time
 from sphera_common import (REPO_ROOT, SHARED_DATA_DIR, UPSTREAM_COLMAP,
                            eucm160_rig, extract_features, fisheye160_rig,
                            fisheye190_rig,
-                           hybrid_rig,
+                           hybrid_rig, thinprism160_rig,
                            match_exhaustive, median, model_counts, poles_rig,
                            read_text_cameras, read_text_images, run_logged)
 
@@ -139,6 +141,7 @@ DATASET_MODELS = {
     "room_fisheye190": ["UNIFIED_OMNI"],
     "room_fisheye160": ["OPENCV_FISHEYE"],
     "room_eucm160": ["EUCM"],
+    "room_thinprism160": ["THIN_PRISM_FISHEYE"],
     "room_hybrid": ["EQUIRECTANGULAR", "UNIFIED_OMNI", "PINHOLE"],
     "room_poles": ["EQUIRECTANGULAR"],
     "room_pinhole_ring": ["PINHOLE"],
@@ -157,7 +160,8 @@ BUILD_DIR = os.path.join(REPO_ROOT, "build")
 BUILD_HINT = "scripts/build.sh"
 REFERENCE = "upstream"
 REFERENCE_TITLE = "upstream COLMAP 4.x"
-REFERENCE_MODELS = {"PINHOLE", "EQUIRECTANGULAR", "OPENCV_FISHEYE", "EUCM"}
+REFERENCE_MODELS = {"PINHOLE", "EQUIRECTANGULAR", "OPENCV_FISHEYE",
+                    "THIN_PRISM_FISHEYE", "EUCM"}
 REFERENCE_BUILDER = os.path.normpath(os.path.join(
     REPO_ROOT, "..", "shared", "peers", "build_colmap4.sh"))
 REFERENCE_BUILD_MINUTES = 40
@@ -367,6 +371,8 @@ RENDERED = {
     "room_fisheye190": {"rig": fisheye190_rig},
     "room_fisheye160": {"rig": fisheye160_rig, "options": ["--realistic"]},
     "room_eucm160": {"rig": eucm160_rig, "options": ["--realistic"]},
+    "room_thinprism160": {"rig": thinprism160_rig,
+                          "options": ["--realistic"]},
     "room_hybrid": {"rig": hybrid_rig},
     "room_poles": {"rig": poles_rig},
     "room_pinhole_ring": {"layout": ["--layout", "ring"]},

@@ -681,6 +681,22 @@ def eucm160_rig():
     return fisheye190_rig("EUCM", EUCM160_PARAMS)
 
 
+# Kannala-Brandt lens with tangential and thin-prism terms, 1024x1024: the
+# radial terms of FISHEYE160_PARAMS (k1, k2 at positions 4, 5 and k3, k4 at
+# 8, 9 in THIN_PRISM_FISHEYE's order), p1 = p2 = 2e-4, sx1 = sy1 = 1e-4; 160
+# degrees (79.9 to 80.1 by direction) across the same 537 px image circle,
+# the frame's edges at 512 px 76.3 to 76.5 degrees off the axis, monotone
+# (Jacobian determinant above 0.99) out to 100 degrees.
+THINPRISM160_PARAMS = [374.3, 374.3, 512, 512, 0.02, -0.004, 2e-4, 2e-4,
+                       0.0006, -0.00005, 1e-4, 1e-4]
+
+
+def thinprism160_rig():
+    """The 12 poses of fisheye190_rig with THIN_PRISM_FISHEYE lenses under
+    180 degrees, which upstream COLMAP knows too."""
+    return fisheye190_rig("THIN_PRISM_FISHEYE", THINPRISM160_PARAMS)
+
+
 def hybrid_rig():
     """4 equirect at the grid corners, 4 fisheye at the grid edges, 4 pinhole
     near the centre looking out at the room's corners."""

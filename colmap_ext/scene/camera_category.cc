@@ -2,6 +2,7 @@
 
 #include "camera_models/eucm.h"
 #include "camera_models/kannala_brandt.h"
+#include "colmap_ext/util/recent_answers.h"
 
 #include <type_traits>
 
@@ -33,16 +34,13 @@ UpstreamCategory CategoryInFront(const std::vector<double>& params,
   }
 }
 
-}  // namespace
-
-UpstreamCategory InFrontCameraCategory(const Camera& camera) {
-  if (!camera.has_prior_focal_length) {
-    return UpstreamCategory::kNone;
-  }
-  const std::vector<double>& params = camera.params;
-  const size_t width = camera.width;
-  const size_t height = camera.height;
-  switch (static_cast<int>(camera.model_id)) {
+// The category of a camera of MODEL_ID with PARAMS in a WIDTH x HEIGHT
+// frame (InFrontCameraCategory, its intrinsics the user's).
+UpstreamCategory CategoryOf(const CameraModelId model_id,
+                            const std::vector<double>& params,
+                            const size_t width,
+                            const size_t height) {
+  switch (static_cast<int>(model_id)) {
     case sphera::OpenCVFisheyeModel::kModelId:
       return CategoryInFront<sphera::OpenCVFisheyeModel,
                              OpenCVFisheyeCameraModel>(params, width, height);
@@ -56,6 +54,28 @@ UpstreamCategory InFrontCameraCategory(const Camera& camera) {
     default:
       return UpstreamCategory::kNone;
   }
+}
+
+}  // namespace
+
+UpstreamCategory InFrontCameraCategory(const Camera& camera) {
+  if (!camera.has_prior_focal_length) {
+    return UpstreamCategory::kNone;
+  }
+  // Asked for every estimate the camera takes part in; the answer scans its
+  // image circle.
+  thread_local RecentAnswers<UpstreamCategory> answers;
+  return answers.Get(static_cast<int>(camera.model_id),
+                     camera.width,
+                     camera.height,
+                     camera.params.data(),
+                     camera.params.size(),
+                     [&camera] {
+                       return CategoryOf(camera.model_id,
+                                         camera.params,
+                                         camera.width,
+                                         camera.height);
+                     });
 }
 
 }  // namespace colmap

@@ -20,6 +20,7 @@
 #include "camera_models/kannala_brandt.h"
 #include "camera_models/ocam.h"
 #include "camera_models/unified_omni.h"
+#include "colmap_ext/util/recent_answers.h"
 
 #include <array>
 #include <cmath>
@@ -200,9 +201,17 @@ struct SphereCameraModelAdapter : public BaseSphericalCameraModel<CameraModel> {
                                     T /*min_focal_length_ratio*/,
                                     T /*max_focal_length_ratio*/,
                                     T /*max_extra_param*/) {
-    return !SphereModel::CheckParams(
-                params, static_cast<int>(width), static_cast<int>(height))
-                .empty();
+    // The check scans the lens's field; the mapper asks it for every
+    // correspondence of the image it registers, with the same parameters.
+    thread_local RecentAnswers<bool> answers;
+    return answers.Get(SphereModel::kModelId, width, height, params.data(),
+                       params.size(), [&] {
+                         return !SphereModel::CheckParams(
+                                     params,
+                                     static_cast<int>(width),
+                                     static_cast<int>(height))
+                                     .empty();
+                       });
   }
 
   // Focal length and principal point follow the image size; the shape
