@@ -224,14 +224,22 @@ class AngularReprojectionConstantPoseCost {
 // model (ImageFromRay); a difference of projections over STEP radians,
 // forwards or, where that leaves the lens's field, backwards (relative
 // error about STEP); with T a Jet, W carries its derivatives by PARAMS and
-// U. False when a projection fails.
+// U. PIXEL_OF_U, when the caller has it (U lifted from that pixel at
+// PARAMS: its projection, whose derivatives by PARAMS vanish), saves one
+// projection. False when a projection fails.
 template <typename Model, typename T>
 bool PixelFromTangentAtRay(const T* params, const T* u, T* w,
-                           double step = 1e-4) {
+                           double step = 1e-4,
+                           const T* pixel_of_u = nullptr) {
   T e[2][3];
   RayTangentBasis(u, e[0], e[1]);
   T centre[2];
-  if (!Model::ImageFromRay(params, u, centre)) return false;
+  if (pixel_of_u != nullptr) {
+    centre[0] = pixel_of_u[0];
+    centre[1] = pixel_of_u[1];
+  } else if (!Model::ImageFromRay(params, u, centre)) {
+    return false;
+  }
   for (int c = 0; c < 2; ++c) {
     bool projected = false;
     for (const double h : {step, -step}) {

@@ -130,11 +130,13 @@ AngularWeight AngularResidualWeight(const double* camera_params,
 // the ray as the camera now is (sphera::PixelFromTangentAtRay), so that W r
 // is the pixel residual to first order at every value of the parameters
 // being refined (see the header comment); with T a Jet it carries the
-// metric's own derivatives by the parameters. WEIGHT's one scale where
+// metric's own derivatives by the parameters. OBSERVED_RAY is
+// OBSERVED_PIXEL lifted at CAMERA_PARAMS. WEIGHT's one scale where
 // AngularResidualWeight found none or the projection fails.
 template <typename CameraModel, typename T>
 Eigen::Matrix<T, 2, 2> AngularWeightAt(const AngularWeight& weight,
                                        const T* camera_params,
+                                       const T* observed_pixel,
                                        const T* observed_ray) {
   using SphereModel = typename SphereMathOf<CameraModel>::type;
   Eigen::Matrix<T, 2, 2> isotropic;
@@ -146,7 +148,7 @@ Eigen::Matrix<T, 2, 2> AngularWeightAt(const AngularWeight& weight,
     Eigen::Matrix<T, 2, 2, Eigen::RowMajor> w;
     if (weight.isotropic ||
         !sphera::PixelFromTangentAtRay<SphereModel>(
-            camera_params, observed_ray, w.data())) {
+            camera_params, observed_ray, w.data(), 1e-4, observed_pixel)) {
       return isotropic;
     }
     return w;
@@ -175,7 +177,8 @@ bool AngularReprojResidual(const T* camera_params,
         observed_ray, point3D_in_cam.data(), log_map.data());
     Eigen::Map<Eigen::Matrix<T, 2, 1>> residual_map(residuals);
     residual_map =
-        AngularWeightAt<CameraModel>(weight, camera_params, observed_ray) *
+        AngularWeightAt<CameraModel>(
+            weight, camera_params, pixel, observed_ray) *
         log_map;
     return true;
   }
@@ -213,7 +216,8 @@ bool AngularReprojResidualWithJacobians(const double* camera_params,
           log_map.data(),
           J_point_in_cam != nullptr ? J_log_map.data() : nullptr);
       const Eigen::Matrix2d w =
-          AngularWeightAt<CameraModel>(weight, camera_params, observed_ray);
+          AngularWeightAt<CameraModel>(
+              weight, camera_params, pixel, observed_ray);
       Eigen::Map<Eigen::Vector2d> residual_map(residuals);
       residual_map = w * log_map;
       if (J_point_in_cam != nullptr) {
@@ -223,8 +227,10 @@ bool AngularReprojResidualWithJacobians(const double* camera_params,
       }
       return true;
     }
-    // Derivatives: the camera parameters first, then the point.
-    using Jet = ceres::Jet<double, kNumParams + 3>;
+    // Derivatives by the camera parameters in Jets of their number (the
+    // ray, the metric and the log map at the point's value); by the point
+    // in doubles (the metric does not depend on it).
+    using Jet = ceres::Jet<double, kNumParams>;
     Jet params[kNumParams];
     for (int i = 0; i < kNumParams; ++i) {
       params[i] = Jet(camera_params[i], i);
@@ -234,24 +240,31 @@ bool AngularReprojResidualWithJacobians(const double* camera_params,
     if (!SphereModel::RayFromImage(params, pixel, observed_ray)) {
       return false;
     }
-    const Jet point[3] = {Jet(point3D_in_cam[0], kNumParams),
-                          Jet(point3D_in_cam[1], kNumParams + 1),
-                          Jet(point3D_in_cam[2], kNumParams + 2)};
+    const Jet point[3] = {Jet(point3D_in_cam[0]), Jet(point3D_in_cam[1]),
+                          Jet(point3D_in_cam[2])};
     Eigen::Matrix<Jet, 2, 1> log_map;
     sphera::AngularLogResidual(observed_ray, point, log_map.data());
-    const Eigen::Matrix<Jet, 2, 1> residual =
-        AngularWeightAt<CameraModel>(weight, params, observed_ray) *
-        log_map;
+    const Eigen::Matrix<Jet, 2, 2> w =
+        AngularWeightAt<CameraModel>(weight, params, pixel, observed_ray);
+    const Eigen::Matrix<Jet, 2, 1> residual = w * log_map;
     for (int row = 0; row < 2; ++row) {
       residuals[row] = residual(row).a;
       for (int i = 0; i < kNumParams; ++i) {
         J_params[row * kNumParams + i] = residual(row).v[i];
       }
-      if (J_point_in_cam != nullptr) {
-        for (int k = 0; k < 3; ++k) {
-          J_point_in_cam[row * 3 + k] = residual(row).v[kNumParams + k];
-        }
-      }
+    }
+    if (J_point_in_cam != nullptr) {
+      const double ray_value[3] = {
+          observed_ray[0].a, observed_ray[1].a, observed_ray[2].a};
+      Eigen::Vector2d log_value;
+      Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J_log_map;
+      sphera::AngularLogResidualWithJacobian(
+          ray_value, point3D_in_cam, log_value.data(), J_log_map.data());
+      Eigen::Matrix2d w_value;
+      w_value << w(0, 0).a, w(0, 1).a, w(1, 0).a, w(1, 1).a;
+      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> J_map(
+          J_point_in_cam);
+      J_map = w_value * J_log_map;
     }
     return true;
   }
