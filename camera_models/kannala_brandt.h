@@ -84,15 +84,28 @@ struct KannalaBrandtField {
 
 // theta_max of the radial coefficients k = (k1, k2, k3, k4): the first root of
 // dr/dtheta, a quartic in theta², in (0, pi²]. NaN coefficients give
-// theta_max = 0 (nothing visible). The last answer is kept per thread: the
-// renderer and bundle adjustment ask with the same lens for every pixel.
+// theta_max = 0 (nothing visible). The last answers for a few lenses are
+// kept per thread: the renderer and bundle adjustment ask with the same
+// lenses for every pixel, and a rig's lenses alternate.
 inline KannalaBrandtField KannalaBrandtFieldOfView(const double* k) {
-  thread_local std::array<double, 4> cached_k = {
-      std::numeric_limits<double>::quiet_NaN(), 0, 0, 0};
-  thread_local KannalaBrandtField cached = {0, false};
-  if (k[0] == cached_k[0] && k[1] == cached_k[1] && k[2] == cached_k[2] &&
-      k[3] == cached_k[3]) {
-    return cached;
+  constexpr int kKept = 8;
+  struct Kept {
+    std::array<double, 4> k;
+    KannalaBrandtField field;
+  };
+  thread_local std::array<Kept, kKept> kept = [] {
+    std::array<Kept, kKept> empty;
+    for (Kept& entry : empty) {
+      entry = {{std::numeric_limits<double>::quiet_NaN(), 0, 0, 0}, {0, false}};
+    }
+    return empty;
+  }();
+  thread_local int next = 0;
+  for (const Kept& entry : kept) {
+    if (k[0] == entry.k[0] && k[1] == entry.k[1] && k[2] == entry.k[2] &&
+        k[3] == entry.k[3]) {
+      return entry.field;
+    }
   }
   const double slope_in_theta2[5] = {1, 3 * k[0], 5 * k[1], 7 * k[2], 9 * k[3]};
   KannalaBrandtField field = {kPi, false};
@@ -100,8 +113,8 @@ inline KannalaBrandtField KannalaBrandtFieldOfView(const double* k) {
   if (FirstNonPositive(slope_in_theta2, 5, 0.0, kPi * kPi, &theta2_fold)) {
     field = {std::sqrt(theta2_fold), true};
   }
-  cached_k = {k[0], k[1], k[2], k[3]};
-  cached = field;
+  kept[next] = {{k[0], k[1], k[2], k[3]}, field};
+  next = (next + 1) % kKept;
   return field;
 }
 

@@ -168,6 +168,29 @@ TEST(KannalaBrandtFieldOfView, FoldMatchesDenseScan) {
   }
 }
 
+// The answers are kept per thread for a few lenses: asked in turn, more
+// lenses than it keeps and back, each lens gets its own field every time.
+TEST(KannalaBrandtFieldOfView, LensesAskedInTurnGetTheirOwnField) {
+  std::vector<std::vector<double>> lenses;
+  std::vector<double> scans;
+  for (int i = 0; i < 12; ++i) {
+    lenses.push_back({-0.01 - 0.001 * i, 0.002, -0.0015, 0.0001});
+    scans.push_back(FoldByScan(lenses.back()));
+  }
+  for (int round = 0; round < 3; ++round) {
+    for (size_t count : {2u, 12u}) {
+      for (size_t i = 0; i < count; ++i) {
+        EXPECT_NEAR(internal::KannalaBrandtFieldOfView(lenses[i].data())
+                        .theta_max,
+                    scans[i], 2e-6)
+            << "lens " << i << " of " << count << ", round " << round;
+      }
+    }
+  }
+  EXPECT_LT(scans[0], kPi);
+  EXPECT_GT(scans[0] - scans[11], 0.01);  // the lenses differ
+}
+
 template <typename Model>
 class KannalaBrandtTest : public ::testing::Test {
  protected:
