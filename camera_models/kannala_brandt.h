@@ -51,6 +51,7 @@
 #include "camera_models/common.h"
 #include "camera_models/fold.h"
 #include "camera_models/polynomial.h"
+#include "camera_models/recent_answers.h"
 
 namespace sphera {
 namespace internal {
@@ -88,34 +89,16 @@ struct KannalaBrandtField {
 // kept per thread: the renderer and bundle adjustment ask with the same
 // lenses for every pixel, and a rig's lenses alternate.
 inline KannalaBrandtField KannalaBrandtFieldOfView(const double* k) {
-  constexpr int kKept = 8;
-  struct Kept {
-    std::array<double, 4> k;
-    KannalaBrandtField field;
-  };
-  thread_local std::array<Kept, kKept> kept = [] {
-    std::array<Kept, kKept> empty;
-    for (Kept& entry : empty) {
-      entry = {{std::numeric_limits<double>::quiet_NaN(), 0, 0, 0}, {0, false}};
+  thread_local RecentAnswers<KannalaBrandtField, 8, 4> kept;
+  return kept.Get(k, 4, [k] {
+    const double slope_in_theta2[5] = {1, 3 * k[0], 5 * k[1], 7 * k[2],
+                                       9 * k[3]};
+    double theta2_fold;
+    if (FirstNonPositive(slope_in_theta2, 5, 0.0, kPi * kPi, &theta2_fold)) {
+      return KannalaBrandtField{std::sqrt(theta2_fold), true};
     }
-    return empty;
-  }();
-  thread_local int next = 0;
-  for (const Kept& entry : kept) {
-    if (k[0] == entry.k[0] && k[1] == entry.k[1] && k[2] == entry.k[2] &&
-        k[3] == entry.k[3]) {
-      return entry.field;
-    }
-  }
-  const double slope_in_theta2[5] = {1, 3 * k[0], 5 * k[1], 7 * k[2], 9 * k[3]};
-  KannalaBrandtField field = {kPi, false};
-  double theta2_fold;
-  if (FirstNonPositive(slope_in_theta2, 5, 0.0, kPi * kPi, &theta2_fold)) {
-    field = {std::sqrt(theta2_fold), true};
-  }
-  kept[next] = {{k[0], k[1], k[2], k[3]}, field};
-  next = (next + 1) % kKept;
-  return field;
+    return KannalaBrandtField{kPi, false};
+  });
 }
 
 // The theta-plane point (a, b) of a ray and the value of theta. Near the

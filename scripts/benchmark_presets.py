@@ -40,9 +40,13 @@ Usage (from the repository root, after scripts/build.sh):
                                         the lenses start from that model
 Output (--output, default build/bench_presets): preset_runs.csv (every run),
 preset_results.csv (median and min..max per camera), preset_results.png,
-logs and the demo's folders under runs/.
+logs and the demo's folders under runs/. Runs of an earlier call into the
+same output that this call does not repeat (other cameras or seeds, e.g.
+--first_seed 2 --repeats 3 after seeds 0-1) are kept in both CSVs and the
+plot: use another --output for another program or option.
 """
 import argparse
+import csv
 import json
 import math
 import os
@@ -327,6 +331,27 @@ SPREAD = ["rot_median_deg", "pos_median_mm", "lens_rot_max_deg",
           "lens_centre_max_mm", "t_demo_s"]
 
 
+def as_number(text):
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def earlier_runs(path, names, seeds):
+    """The rows of an earlier preset_runs.csv at PATH that this call does not
+    repeat (a camera of NAMES with a seed of SEEDS), numbers as numbers."""
+    if not os.path.exists(path):
+        return []
+    with open(path, newline="") as f:
+        rows = [{k: as_number(v) for k, v in row.items() if v not in ("", None)}
+                for row in csv.DictReader(f)]
+    return [row for row in rows
+            if row.get("camera") not in names or row.get("seed") not in seeds]
+
+
 def summarize(runs):
     summary = []
     for name in dict.fromkeys(r["camera"] for r in runs):
@@ -433,9 +458,13 @@ def main():
         if name not in CAMERAS:
             sys.exit(f"error: --cameras {name}: one of {', '.join(CAMERAS)}")
     os.makedirs(args.output, exist_ok=True)
-    runs = []
+    seeds = range(args.first_seed, args.first_seed + args.repeats)
+    runs_csv = os.path.join(args.output, "preset_runs.csv")
+    runs = earlier_runs(runs_csv, names, seeds)
+    if runs:
+        log(f"kept {len(runs)} run(s) of an earlier call in {runs_csv}")
     for name in names:
-        for seed in range(args.first_seed, args.first_seed + args.repeats):
+        for seed in seeds:
             work = os.path.join(args.output, "runs", f"{name}_seed{seed}")
             shutil.rmtree(work, ignore_errors=True)
             log(f"{name} seed {seed}")
@@ -446,7 +475,7 @@ def main():
             log("  " + ", ".join(f"{k} {fmt(v)}" for k, v in row.items()
                                  if k not in ("camera", "preset", "seed")))
             runs.append(row)
-            write_csv(os.path.join(args.output, "preset_runs.csv"), runs)
+            write_csv(runs_csv, runs)
     summary = summarize(runs)
     print_table(summary)
     write_csv(os.path.join(args.output, "preset_results.csv"), summary)

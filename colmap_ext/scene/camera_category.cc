@@ -2,7 +2,7 @@
 
 #include "camera_models/eucm.h"
 #include "camera_models/kannala_brandt.h"
-#include "colmap_ext/util/recent_answers.h"
+#include "camera_models/recent_answers.h"
 
 #include <type_traits>
 
@@ -64,10 +64,12 @@ UpstreamCategory InFrontCameraCategory(const Camera& camera) {
   }
   // Asked for every estimate the camera takes part in; the answer scans its
   // image circle.
-  thread_local RecentAnswers<UpstreamCategory> answers;
-  return answers.Get(static_cast<int>(camera.model_id),
-                     camera.width,
-                     camera.height,
+  thread_local sphera::RecentAnswers<UpstreamCategory> answers;
+  const double key[3] = {static_cast<double>(camera.model_id),
+                         static_cast<double>(camera.width),
+                         static_cast<double>(camera.height)};
+  return answers.Get(key,
+                     3,
                      camera.params.data(),
                      camera.params.size(),
                      [&camera] {

@@ -19,8 +19,8 @@
 #include "camera_models/eucm.h"
 #include "camera_models/kannala_brandt.h"
 #include "camera_models/ocam.h"
+#include "camera_models/recent_answers.h"
 #include "camera_models/unified_omni.h"
-#include "colmap_ext/util/recent_answers.h"
 
 #include <array>
 #include <cmath>
@@ -203,15 +203,16 @@ struct SphereCameraModelAdapter : public BaseSphericalCameraModel<CameraModel> {
                                     T /*max_extra_param*/) {
     // The check scans the lens's field; the mapper asks it for every
     // correspondence of the image it registers, with the same parameters.
-    thread_local RecentAnswers<bool> answers;
-    return answers.Get(SphereModel::kModelId, width, height, params.data(),
-                       params.size(), [&] {
-                         return !SphereModel::CheckParams(
-                                     params,
-                                     static_cast<int>(width),
-                                     static_cast<int>(height))
-                                     .empty();
-                       });
+    thread_local sphera::RecentAnswers<bool> answers;
+    const double camera[3] = {static_cast<double>(SphereModel::kModelId),
+                              static_cast<double>(width),
+                              static_cast<double>(height)};
+    return answers.Get(camera, 3, params.data(), params.size(), [&] {
+      return !SphereModel::CheckParams(params,
+                                       static_cast<int>(width),
+                                       static_cast<int>(height))
+                  .empty();
+    });
   }
 
   // Focal length and principal point follow the image size; the shape

@@ -1,19 +1,22 @@
-#include "colmap_ext/util/recent_answers.h"
+#include "camera_models/recent_answers.h"
 
 #include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-namespace colmap {
+namespace sphera {
 namespace {
 
-// How many times a check was computed behind RecentAnswers.
+// How many times a check was computed behind RecentAnswers, keyed on a
+// camera's (model id, width) and its parameters.
 struct CountedCheck {
   int calls = 0;
-  RecentAnswers<int, 2, 3> answers;
-  int Ask(int model_id, size_t width, const std::vector<double>& params) {
-    return answers.Get(model_id, width, 10, params.data(), params.size(),
+  RecentAnswers<int, 2, 5> answers;
+  int Ask(int model_id, int width, const std::vector<double>& params) {
+    const double camera[2] = {static_cast<double>(model_id),
+                              static_cast<double>(width)};
+    return answers.Get(camera, 2, params.data(), params.size(),
                        [&] { return ++calls; });
   }
 };
@@ -47,7 +50,7 @@ TEST(RecentAnswers, KeepsTheLastFewAndForgetsTheOldest) {
   EXPECT_EQ(check.calls, 4);
 }
 
-TEST(RecentAnswers, NaNParametersAreNeverKept) {
+TEST(RecentAnswers, NaNKeysAreAlwaysComputed) {
   CountedCheck check;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   check.Ask(5, 100, {nan});
@@ -55,12 +58,23 @@ TEST(RecentAnswers, NaNParametersAreNeverKept) {
   EXPECT_EQ(check.calls, 2);
 }
 
-TEST(RecentAnswers, LongParameterVectorsAreNotKept) {
-  CountedCheck check;  // at most 3 parameters
+TEST(RecentAnswers, LongKeysAreNotKept) {
+  CountedCheck check;  // at most 5 numbers: 2 of the camera, 3 parameters
   check.Ask(5, 100, {1, 2, 3, 4});
   check.Ask(5, 100, {1, 2, 3, 4});
   EXPECT_EQ(check.calls, 2);
+  check.Ask(5, 100, {1, 2, 3});
+  check.Ask(5, 100, {1, 2, 3});
+  EXPECT_EQ(check.calls, 3);
+}
+
+TEST(RecentAnswers, AnEmptyCacheMatchesNoKey) {
+  RecentAnswers<int, 2, 3> answers;
+  int calls = 0;
+  EXPECT_EQ(answers.Get(nullptr, 0, [&] { return ++calls + 10; }), 11);
+  EXPECT_EQ(answers.Get(nullptr, 0, [&] { return ++calls + 10; }), 11);
+  EXPECT_EQ(calls, 1);
 }
 
 }  // namespace
-}  // namespace colmap
+}  // namespace sphera
