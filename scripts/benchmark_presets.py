@@ -46,7 +46,6 @@ same output that this call does not repeat (other cameras or seeds, e.g.
 plot: use another --output for another program or option.
 """
 import argparse
-import csv
 import json
 import math
 import os
@@ -331,27 +330,6 @@ SPREAD = ["rot_median_deg", "pos_median_mm", "lens_rot_max_deg",
           "lens_centre_max_mm", "t_demo_s"]
 
 
-def as_number(text):
-    for kind in (int, float):
-        try:
-            return kind(text)
-        except ValueError:
-            pass
-    return text
-
-
-def earlier_runs(path, names, seeds):
-    """The rows of an earlier preset_runs.csv at PATH that this call does not
-    repeat (a camera of NAMES with a seed of SEEDS), numbers as numbers."""
-    if not os.path.exists(path):
-        return []
-    with open(path, newline="") as f:
-        rows = [{k: as_number(v) for k, v in row.items() if v not in ("", None)}
-                for row in csv.DictReader(f)]
-    return [row for row in rows
-            if row.get("camera") not in names or row.get("seed") not in seeds]
-
-
 def summarize(runs):
     summary = []
     for name in dict.fromkeys(r["camera"] for r in runs):
@@ -460,7 +438,9 @@ def main():
     os.makedirs(args.output, exist_ok=True)
     seeds = range(args.first_seed, args.first_seed + args.repeats)
     runs_csv = os.path.join(args.output, "preset_runs.csv")
-    runs = earlier_runs(runs_csv, names, seeds)
+    runs = common.earlier_runs(
+        runs_csv, lambda row: row.get("camera") in names
+        and row.get("seed") in seeds)
     if runs:
         log(f"kept {len(runs)} run(s) of an earlier call in {runs_csv}")
     for name in names:

@@ -514,16 +514,11 @@ def main():
     common.COLMAP = args.colmap
     # Runs of an earlier call into the same output that this one does not
     # repeat are kept (e.g. --systems one_lens after a full run).
-    runs = []
     runs_csv = os.path.join(args.output, "rig_runs.csv")
-    if os.path.exists(runs_csv):
-        with open(runs_csv) as f:
-            runs = [{k: v for k, v in row.items() if v != ""}
-                    for row in csv.DictReader(f)]
-        runs = [row for row in runs
-                if row.get("system") not in systems
-                or int(row.get("seed", -1)) not in seeds
-                or row.get("preset") not in args.presets.split(",")]
+    runs = common.earlier_runs(
+        runs_csv, lambda row: row.get("system") in systems
+        and row.get("seed") in seeds
+        and row.get("preset") in args.presets.split(","))
     for seed in seeds:
         for preset in args.presets.split(","):
             scene = os.path.join(args.output, f"scene_{preset}_{seed}")

@@ -4,6 +4,7 @@ renderer sphera_render, and the camera rigs of the rendered sets.
 
 Standard library only; the functions that need numpy import it themselves,
 so that a script that does not use them starts without it."""
+import csv
 import hashlib
 import math
 import os
@@ -392,6 +393,27 @@ def rig_errors(gt_path, model_path):
         errors[folder] = (float(np.degrees(angle)),
                           float(np.linalg.norm(centre - gt_centre)))
     return errors
+
+
+def earlier_runs(path, repeated):
+    """The rows of a benchmark's runs CSV at PATH (written by an earlier call
+    into the same output) for which REPEATED(row) is false, i.e. the runs this
+    call does not repeat; empty cells left out, numbers as numbers."""
+    if not os.path.exists(path):
+        return []
+
+    def value(text):
+        for kind in (int, float):
+            try:
+                return kind(text)
+            except ValueError:
+                pass
+        return text
+
+    with open(path, newline="") as f:
+        rows = [{k: value(v) for k, v in row.items() if v not in ("", None)}
+                for row in csv.DictReader(f)]
+    return [row for row in rows if not repeated(row)]
 
 
 def medians_and_spreads(rows, keys, spread_keys):
