@@ -26,13 +26,15 @@ set(SPHERA_COLMAP_SCENE_TYPES_SRCS
 # Sources of colmap_ext/scene/ that the patch series compiles into COLMAP's
 # colmap_scene library (the database opens through them and checks its
 # cameras; the mapper, in colmap_sfm above it, checks refined intrinsics
-# with them).
+# with them; projection.cc measures a spherical camera's reprojection error
+# with one).
 set(SPHERA_COLMAP_SCENE_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/scene/camera_params_error.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/database_check.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/intrinsics_divergence.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/points_at_camera_center.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/rig_config.cc
+  ${CMAKE_CURRENT_LIST_DIR}/scene/sphere_reprojection_error.cc
   ${CMAKE_CURRENT_LIST_DIR}/scene/unused_cameras.cc)
 # Sources of colmap_ext/sfm/ that the patch series compiles into COLMAP's
 # colmap_sfm library (the incremental mapper's initial pair search and its

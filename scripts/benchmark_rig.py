@@ -36,7 +36,12 @@ Usage (from the repository root, after scripts/build.sh):
                                                   maps the databases of an
                                                   earlier output again (the
                                                   same options), e.g. with
-                                                  another --colmap
+                                                  another --colmap; with
+                                                  --fit_model, the rig is
+                                                  configured again from that
+                                                  model's rough start (the
+                                                  earlier run's verified
+                                                  matches kept)
   scripts/benchmark_rig.py --start_focal_scale 1.2 --start_no_distortion ...
                                                   self-calibration: the rig
                                                   starts from focal lengths
@@ -228,6 +233,15 @@ def run_system(scene, preset, system, work, program, num_lenses,
         image_path = os.path.join(scene, "stitched", "images") \
             if system.startswith("stitched") else os.path.join(scene, "images")
         t_extract = t_match = 0.0
+        if system == "rig" and fit_model:
+            # The same features and verified matches, the lenses started
+            # again from FIT_MODEL's rough parameters.
+            config = os.path.join(work, "rig_config.json")
+            fitted_rig_config(scene, config, fit_model,
+                              PRESET_HALF_FIELD_DEG[preset])
+            timed(program, ["rig_configurator", "--database_path", database,
+                            "--rig_config_path", config],
+                  os.path.join(logs, "rig.log"))
     elif system == "rig":
         image_path = os.path.join(scene, "images")
         t_extract = timed(program, [
