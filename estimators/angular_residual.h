@@ -41,11 +41,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
+
+#include "camera_models/common.h"
 
 namespace sphera {
 
@@ -216,6 +219,40 @@ class AngularReprojectionConstantPoseCost {
   Eigen::Matrix3d A_;
   Eigen::Vector3d b_;
 };
+
+// Model::RayFromImage (a camera_models/ model), succeeding wherever the lift
+// of the scalar parts succeeds. In Jets a model's arithmetic rounds
+// differently (ceres::Jet divides by multiplying with the reciprocal), so at
+// the edge of its domain (where radial distortion folds, or Newton's
+// iteration stops converging) the Jet lift can fail on a pixel whose lift in
+// doubles succeeds. Ceres asks for derivatives only where it has evaluated
+// the cost, and a failure there ends the whole solve; so where only the Jet
+// lift fails, the ray of the scalar parts is returned without derivatives
+// by the parameters.
+template <typename Model, typename T>
+bool RayFromImageOrScalarRay(const T* params, const T* pixel, T* ray_in_cam) {
+  if (Model::RayFromImage(params, pixel, ray_in_cam)) {
+    return true;
+  }
+  if constexpr (std::is_same_v<T, double>) {
+    return false;
+  } else {
+    double scalar_params[Model::kNumParams];
+    for (int i = 0; i < Model::kNumParams; ++i) {
+      scalar_params[i] = internal::ScalarPart(params[i]);
+    }
+    const double scalar_pixel[2] = {internal::ScalarPart(pixel[0]),
+                                    internal::ScalarPart(pixel[1])};
+    double scalar_ray[3];
+    if (!Model::RayFromImage(scalar_params, scalar_pixel, scalar_ray)) {
+      return false;
+    }
+    for (int i = 0; i < 3; ++i) {
+      ray_in_cam[i] = T(scalar_ray[i]);
+    }
+    return true;
+  }
+}
 
 // The pixels of a camera along the tangent plane at its ray U: the 2 x 2
 // matrix W (row-major) whose column c is d pixel / d t_c, t the coordinates

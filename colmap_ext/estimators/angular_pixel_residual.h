@@ -132,7 +132,8 @@ bool AngularReprojResidual(const T* camera_params,
   } else {
     const T pixel[2] = {T(observed_pixel.x()), T(observed_pixel.y())};
     T observed_ray[3];
-    if (!SphereModel::RayFromImage(camera_params, pixel, observed_ray)) {
+    if (!sphera::RayFromImageOrScalarRay<SphereModel>(
+            camera_params, pixel, observed_ray)) {
       return false;
     }
     Eigen::Matrix<T, 2, 1> log_map;

@@ -107,7 +107,8 @@ bool AngularReprojResidualWithJacobians(const double* camera_params,
     }
     const Jet pixel[2] = {Jet(observed_pixel.x()), Jet(observed_pixel.y())};
     Jet observed_ray[3];
-    if (!SphereModel::RayFromImage(params, pixel, observed_ray)) {
+    if (!sphera::RayFromImageOrScalarRay<SphereModel>(
+            params, pixel, observed_ray)) {
       return false;
     }
     const Jet point[3] = {Jet(point3D_in_cam[0]), Jet(point3D_in_cam[1]),

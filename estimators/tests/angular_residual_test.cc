@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <random>
+#include <type_traits>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "camera_models/unified_omni.h"
 #include "estimators/tests/test_utils.h"
 
 namespace sphera {
@@ -211,6 +213,88 @@ TEST(AngularResidual, AnalyticJacobianMatchesJets) {
   EXPECT_EQ(r[0], M_PI);
   EXPECT_EQ(r[1], 0);
   for (double x : J) EXPECT_EQ(x, 0);
+}
+
+// A model whose lift succeeds in doubles and fails in Jets: what rounding
+// does to a pixel at the edge of a real model's domain.
+struct LiftsOnlyInDoubles {
+  static constexpr int kNumParams = 1;
+  template <typename T>
+  static bool RayFromImage(const T* params, const T* pixel, T* ray) {
+    if constexpr (!std::is_same_v<T, double>) {
+      return false;
+    } else {
+      if (pixel[0] > params[0]) return false;
+      ray[0] = pixel[0] / params[0];
+      ray[1] = 0;
+      ray[2] = std::sqrt(1 - ray[0] * ray[0]);
+      return true;
+    }
+  }
+};
+
+TEST(RayFromImageOrScalarRay, TakesTheScalarRayWhereOnlyTheJetLiftFails) {
+  using Jet = ceres::Jet<double, 1>;
+  const Jet params[1] = {Jet(2.0, 0)};
+  const Jet inside[2] = {Jet(1.0), Jet(0.0)};
+  Jet ray[3];
+  ASSERT_FALSE(LiftsOnlyInDoubles::RayFromImage(params, inside, ray));
+  ASSERT_TRUE(RayFromImageOrScalarRay<LiftsOnlyInDoubles>(params, inside, ray));
+  EXPECT_DOUBLE_EQ(ray[0].a, 0.5);
+  EXPECT_DOUBLE_EQ(ray[2].a, std::sqrt(0.75));
+  EXPECT_EQ(ray[0].v[0], 0.0);  // no derivative by the parameter
+  // Where the scalar lift fails too, so does this one.
+  const Jet outside[2] = {Jet(3.0), Jet(0.0)};
+  EXPECT_FALSE(
+      RayFromImageOrScalarRay<LiftsOnlyInDoubles>(params, outside, ray));
+  // In doubles it is the model's lift.
+  const double scalar_params[1] = {2.0};
+  const double scalar_pixel[2] = {1.0, 0.0};
+  double scalar_ray[3];
+  ASSERT_TRUE(RayFromImageOrScalarRay<LiftsOnlyInDoubles>(
+      scalar_params, scalar_pixel, scalar_ray));
+  EXPECT_DOUBLE_EQ(scalar_ray[0], 0.5);
+}
+
+// A UNIFIED_OMNI lens whose radial distortion folds inside its frame (the
+// parameters bundle adjustment reached on a rendered 8-lens ring): over
+// pixels across the fold, the lift with derivatives succeeds exactly where
+// the lift in doubles does, and then with the same ray. (Without the
+// fallback, ceres::Jet's rounding fails a few of these pixels.)
+TEST(RayFromImageOrScalarRay, AgreesWithTheScalarLiftAcrossAFold) {
+  const double params[9] = {457.71797860362676,    457.1763972184234,
+                            512,                   512,
+                            0.96675571178944697,   -0.031945239643560254,
+                            -0.04826473796719391,  -0.00012990444376227066,
+                            0.0011993448409999166};
+  using Jet = ceres::Jet<double, 9>;
+  Jet jet_params[9];
+  for (int i = 0; i < 9; ++i) jet_params[i] = Jet(params[i], i);
+  int lifted = 0;
+  int not_lifted = 0;
+  for (double dx = -0.0005; dx <= 0.0005; dx += 0.000002) {
+    for (double dy = -0.0005; dy <= 0.0005; dy += 0.00002) {
+      const double pixel[2] = {678.064 + dx, 965.723 + dy};
+      double ray[3];
+      const bool scalar = UnifiedOmniModel::RayFromImage(params, pixel, ray);
+      const Jet jet_pixel[2] = {Jet(pixel[0]), Jet(pixel[1])};
+      Jet jet_ray[3];
+      const bool with_derivatives = RayFromImageOrScalarRay<UnifiedOmniModel>(
+          jet_params, jet_pixel, jet_ray);
+      if (scalar) {
+        ASSERT_TRUE(with_derivatives) << pixel[0] << " " << pixel[1];
+        for (int i = 0; i < 3; ++i) {
+          EXPECT_NEAR(jet_ray[i].a, ray[i], 1e-9);
+        }
+        ++lifted;
+      } else {
+        ++not_lifted;
+      }
+    }
+  }
+  // The grid spans the fold.
+  EXPECT_GT(lifted, 1000);
+  EXPECT_GT(not_lifted, 1000);
 }
 
 }  // namespace
