@@ -79,6 +79,10 @@ AngularWeight AngularResidualWeight(const double* camera_params,
             camera_params, ray, w.data())) {
       return weight;
     }
+    if (!w.allFinite()) {
+      // JacobiSVD need not return on a non-finite matrix.
+      return weight;
+    }
     const Eigen::Vector2d pixels_per_radian =
         Eigen::JacobiSVD<Eigen::Matrix2d>(w).singularValues();
     weight.isotropic = !pixels_per_radian.allFinite() ||
