@@ -405,6 +405,18 @@ PresetResolution FindPresetResolution(const CameraPreset& preset,
                               "\"; known: " + KnownResolutions(preset));
 }
 
+std::string LensModelError(const std::string& model_name) {
+  // The lens models: the sphere models but the panorama's.
+  std::string known;
+  for (const ModelInfo& info : SphereModels()) {
+    if (info.name == std::string("EQUIRECTANGULAR")) continue;
+    if (model_name == info.name) return "";
+    known += (known.empty() ? "" : ", ") + std::string(info.name);
+  }
+  return model_name + ": not a model for the lenses of a 360° camera; one of " +
+         known;
+}
+
 std::string PresetLensModelError(const CameraPreset& preset,
                                  const std::string& model_name) {
   if (model_name.empty() || model_name == preset.model_name) return "";
@@ -413,38 +425,39 @@ std::string PresetLensModelError(const CameraPreset& preset,
            " stores stitched panoramas, one " + preset.model_name +
            " camera";
   }
-  // The lens models: the sphere models but the panorama's.
-  std::string known;
-  for (const ModelInfo& info : SphereModels()) {
-    if (info.name == std::string("EQUIRECTANGULAR")) continue;
-    if (model_name == info.name) return "";
-    known += (known.empty() ? "" : ", ") + std::string(info.name);
-  }
-  return "--camera_model " + model_name +
-         ": not a model for the lenses of a 360° camera; one of " + known;
+  const std::string error = LensModelError(model_name);
+  return error.empty() ? "" : "--camera_model " + error;
 }
 
-PresetCamera PresetLensCamera(const CameraPreset& preset,
-                              const PresetResolution& resolution, int lens,
-                              const std::string& model_name) {
-  if (const std::string error = PresetLensModelError(preset, model_name);
-      !error.empty()) {
+PresetCamera EquidistantLensCamera(const std::string& model_name,
+                                   const PresetCircle& circle,
+                                   double field_of_view_deg, int width,
+                                   int height) {
+  if (const std::string error = LensModelError(model_name); !error.empty()) {
     throw std::invalid_argument(error);
   }
-  PresetCamera camera;
-  const Eigen::Vector2i size = LensImageSize(preset, resolution);
-  camera.width = size.x();
-  camera.height = size.y();
-  camera.model_name = model_name.empty() ? preset.model_name : model_name;
-  camera.model_id = ModelIdFromName(camera.model_name);
-  if (preset.storage == LensStorage::kEquirectangular) {
-    camera.params = {static_cast<double>(size.x()),
-                     static_cast<double>(size.y())};
-    return camera;
+  if (!(field_of_view_deg > 0 && field_of_view_deg < 360)) {
+    throw std::invalid_argument(
+        "field of view " + std::to_string(field_of_view_deg) +
+        " degrees: must be above 0 and below 360");
   }
-  // The equidistant lens of the circle: radius r at theta_max.
-  const PresetCircle& circle = resolution.circles.at(lens);
-  const double theta_max = preset.field_of_view_deg / 2 * kPi / 180;
+  // Images up to a million pixels wide.
+  constexpr double kMaxPixels = 1e6;
+  if (!(std::abs(circle.cx) <= kMaxPixels && std::abs(circle.cy) <= kMaxPixels &&
+        circle.r >= 1 && circle.r <= kMaxPixels)) {
+    throw std::invalid_argument(
+        "image circle (" + std::to_string(circle.cx) + ", " +
+        std::to_string(circle.cy) + ", " + std::to_string(circle.r) +
+        "): needs a centre within 1e6 pixels and a radius of 1 to 1e6 pixels");
+  }
+  // Without an image size the circle is fitted whole: in an image that just
+  // holds it, the principal point moved back to the circle's centre after.
+  const bool whole = width <= 0 || height <= 0;
+  const int side = static_cast<int>(std::ceil(2 * circle.r)) + 2;
+  const Eigen::Vector2d centre =
+      whole ? Eigen::Vector2d(side / 2.0, side / 2.0)
+            : Eigen::Vector2d(circle.cx, circle.cy);
+  const double theta_max = field_of_view_deg / 2 * kPi / 180;
   const double focal = circle.r / theta_max;
   const ImageFromRayFunction equidistant = [&](const Eigen::Vector3d& ray,
                                                Eigen::Vector2d* pixel) {
@@ -454,7 +467,7 @@ PresetCamera PresetLensCamera(const CameraPreset& preset,
     const Eigen::Vector2d direction =
         radius_xy > 0 ? Eigen::Vector2d(ray.head<2>() / radius_xy)
                       : Eigen::Vector2d::Zero();
-    *pixel = Eigen::Vector2d(circle.cx, circle.cy) + focal * theta * direction;
+    *pixel = centre + focal * theta * direction;
     return true;
   };
   // The lens is exact and symmetric about its axis: a few meridians (the
@@ -462,13 +475,55 @@ PresetCamera PresetLensCamera(const CameraPreset& preset,
   LensSamplingOptions sampling;
   sampling.num_meridians = 16;
   sampling.sample_spacing_deg = 3;
+  const int fit_width = whole ? side : width;
+  const int fit_height = whole ? side : height;
+  PresetCamera camera;
+  camera.model_name = model_name;
+  camera.model_id = ModelIdFromName(model_name);
+  camera.width = whole ? 0 : width;
+  camera.height = whole ? 0 : height;
   const std::vector<RayPixelSample> samples =
-      SampleLensByProjection(equidistant, size.x(), size.y(), sampling);
+      SampleLensByProjection(equidistant, fit_width, fit_height, sampling);
   const ModelConversion fit =
-      FitModelToSamples(camera.model_id, samples, size.x(), size.y());
+      FitModelToSamples(camera.model_id, samples, fit_width, fit_height);
   camera.params = fit.params;
   camera.fit_max_error_px = fit.errors.max_error_px;
+  if (whole) {
+    internal::VisitModel(camera.model_id, [&](auto model) {
+      using Model = decltype(model);
+      static_assert(Model::kPrincipalPointIdxs.size() == 2 ||
+                    Model::kPrincipalPointIdxs.empty());
+      if constexpr (Model::kPrincipalPointIdxs.size() == 2) {
+        camera.params[Model::kPrincipalPointIdxs[0]] += circle.cx - centre.x();
+        camera.params[Model::kPrincipalPointIdxs[1]] += circle.cy - centre.y();
+      }
+    });
+  }
   return camera;
+}
+
+PresetCamera PresetLensCamera(const CameraPreset& preset,
+                              const PresetResolution& resolution, int lens,
+                              const std::string& model_name) {
+  if (const std::string error = PresetLensModelError(preset, model_name);
+      !error.empty()) {
+    throw std::invalid_argument(error);
+  }
+  const Eigen::Vector2i size = LensImageSize(preset, resolution);
+  const std::string name = model_name.empty() ? preset.model_name : model_name;
+  if (preset.storage == LensStorage::kEquirectangular) {
+    PresetCamera camera;
+    camera.width = size.x();
+    camera.height = size.y();
+    camera.model_name = name;
+    camera.model_id = ModelIdFromName(name);
+    camera.params = {static_cast<double>(size.x()),
+                     static_cast<double>(size.y())};
+    return camera;
+  }
+  // The equidistant lens of the circle: radius r at theta_max.
+  return EquidistantLensCamera(name, resolution.circles.at(lens),
+                               preset.field_of_view_deg, size.x(), size.y());
 }
 
 std::vector<PresetCamera> PresetLensCameras(const CameraPreset& preset,

@@ -130,6 +130,24 @@ struct PresetCamera {
   int height = 0;
   double fit_max_error_px = 0;  // of the fit, over the circle
 };
+// Why MODEL_NAME is not a model for a fisheye lens (registry.h's
+// SphereModels but EQUIRECTANGULAR), or "".
+std::string LensModelError(const std::string& model_name);
+
+// The starting camera of a lens known from its specification: MODEL_NAME
+// fitted to the equidistant lens (radius f * theta from the circle's centre,
+// f = r / theta_max) whose field of view FIELD_OF_VIEW_DEG fills CIRCLE, over
+// the part of the circle inside a WIDTH x HEIGHT lens image; with WIDTH or
+// HEIGHT 0 over the whole circle, wherever it lies (the result's width and
+// height are then 0). Throws std::invalid_argument naming the value: a model
+// LensModelError refuses, a field of view outside (0, 360) degrees, a circle
+// whose centre is not within 1e6 pixels or whose radius is not 1 to 1e6
+// pixels.
+PresetCamera EquidistantLensCamera(const std::string& model_name,
+                                   const PresetCircle& circle,
+                                   double field_of_view_deg, int width = 0,
+                                   int height = 0);
+
 // MODEL_NAME (empty: the preset's model_name) must be a whole-field lens
 // model (PresetLensModelError).
 PresetCamera PresetLensCamera(const CameraPreset& preset,

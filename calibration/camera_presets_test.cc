@@ -196,6 +196,63 @@ TEST(CameraPresets, LensesStartFromAnyWholeFieldModel) {
   EXPECT_NE(ErrorOf([&] { ResolveRigPreset(request); }), "");
 }
 
+TEST(CameraPresets, EquidistantLensCameraFitsTheWholeCircleWhereverItLies) {
+  // A 195° lens whose circle the frame crops top and bottom (its centre 300
+  // px below the top edge of a 1600 x 1088 image, radius 560): fitted over
+  // the whole circle, each model puts the axis on the circle's centre, the
+  // rays at 45° and 90° where the equidistant lens has them and the edge of
+  // the field on the circle.
+  const PresetCircle circle{800.5, 300.25, 560};
+  const double theta_max = 97.5 * kPi / 180;
+  for (const std::string model : {"OPENCV_FISHEYE", "THIN_PRISM_FISHEYE",
+                                  "EUCM", "UNIFIED_OMNI", "DOUBLE_SPHERE",
+                                  "OCAM"}) {
+    const PresetCamera camera = EquidistantLensCamera(model, circle, 195);
+    EXPECT_EQ(camera.model_id, ModelIdFromName(model)) << model;
+    EXPECT_EQ(camera.width, 0) << model;
+    EXPECT_EQ(CheckParams(camera.model_id, camera.params, 1600, 1088), "")
+        << model;
+    EXPECT_LT(camera.fit_max_error_px, 0.005 * circle.r) << model;
+    // RadiusOfRay's ray lies along x for a camera of width >= height.
+    for (const double theta : {0.0, kPi / 4, kPi / 2, theta_max - 1e-6}) {
+      EXPECT_NEAR(RadiusOfRay(camera, circle, theta),
+                  circle.r * theta / theta_max, 0.005 * circle.r)
+          << model << " at " << theta * 180 / kPi << "°";
+    }
+  }
+  // With the image's size, the part inside it is fitted: a preset lens is
+  // that fit (the Theta V at 4K: 1920 x 1920 lens images).
+  const CameraPreset& theta_v = FindCameraPreset("ricoh_theta_v");
+  const PresetResolution resolution = FindPresetResolution(theta_v, "4k");
+  const PresetCamera preset_lens = PresetLensCamera(theta_v, resolution, 0);
+  const PresetCamera same = EquidistantLensCamera(
+      preset_lens.model_name, resolution.circles[0],
+      theta_v.field_of_view_deg, preset_lens.width, preset_lens.height);
+  EXPECT_EQ(same.params, preset_lens.params);
+  EXPECT_EQ(same.width, preset_lens.width);
+  // What a specification cannot start: each refusal names the value.
+  EXPECT_NE(ErrorOf([&] { EquidistantLensCamera("PINHOLE", circle, 195); })
+                .find("PINHOLE: not a model for"),
+            std::string::npos);
+  for (const double fov : {0.0, -10.0, 360.0, std::nan("")}) {
+    EXPECT_NE(ErrorOf([&] { EquidistantLensCamera("EUCM", circle, fov); })
+                  .find("field of view"),
+              std::string::npos)
+        << fov;
+  }
+  for (const PresetCircle bad : {PresetCircle{800, 300, 0},
+                                 PresetCircle{800, 300, -5},
+                                 PresetCircle{800, 300, 0.5},
+                                 PresetCircle{800, 300, 2e6},
+                                 PresetCircle{std::nan(""), 300, 560},
+                                 PresetCircle{800, 300, HUGE_VAL}}) {
+    EXPECT_NE(ErrorOf([&] { EquidistantLensCamera("EUCM", bad, 195); })
+                  .find("image circle"),
+              std::string::npos)
+        << bad.cx << " " << bad.r;
+  }
+}
+
 TEST(CameraPresets, CirclesAreConsistentPerResolution) {
   for (const CameraPreset& preset : CameraPresets()) {
     const std::vector<PresetResolution> resolutions = Resolutions(preset);

@@ -44,6 +44,9 @@ set(SPHERA_COLMAP_SFM_SRCS
   ${CMAKE_CURRENT_LIST_DIR}/sfm/held_bundle_adjustment.cc
   ${CMAKE_CURRENT_LIST_DIR}/sfm/initial_pair_search.cc
   ${CMAKE_CURRENT_LIST_DIR}/sfm/rig_initial_pair.cc)
+# What colmap_scene links for them: a rig config's lens given by its field
+# of view and image circle starts from calibration/'s fit.
+set(SPHERA_COLMAP_SCENE_LIBS $<BUILD_INTERFACE:sphera_calibration>)
 set(SPHERA_COLMAP_CONTROLLER_LIBS
   $<BUILD_INTERFACE:sphera_calibration>
   $<BUILD_INTERFACE:sphera_estimators>

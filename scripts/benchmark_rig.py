@@ -69,6 +69,7 @@ rig), rig_results.png, logs/.
 import argparse
 import csv
 import os
+import shlex
 import shutil
 import sys
 import time
@@ -184,9 +185,12 @@ def rough_start(model, width, height, circle_radius, half_field_deg):
                      "UNIFIED_OMNI, OPENCV_FISHEYE")
 
 
-def fitted_rig_config(scene, path, model, half_field_deg):
+def fitted_rig_config(scene, path, model, half_field_deg, spec=False):
     """The scene's rig_config.json with zero offsets and every lens started
-    from MODEL's rough parameters (rough_start) on its image circle."""
+    from MODEL's rough parameters (rough_start) on its image circle; SPEC:
+    from the lens's field of view and image circle instead, which
+    rig_configurator turns into MODEL fitted to the equidistant lens of that
+    circle (as `colmap rig_preset` starts a known camera's lenses)."""
     import json
     with open(os.path.join(scene, "rig_config.json")) as f:
         config = common.without_rig_offsets(json.load(f))
@@ -194,25 +198,33 @@ def fitted_rig_config(scene, path, model, half_field_deg):
     with open(os.path.join(scene, "circles.txt")) as f:
         for line in f:
             if line.strip() and not line.startswith("#"):
-                name, _, _, radius = line.split()
-                circles[name] = float(radius)
+                name, cx, cy, radius = line.split()
+                circles[name] = (float(cx), float(cy), float(radius))
     _, width, height, _ = next(iter(common.read_text_cameras(
         os.path.join(scene, "sparse_gt")).values()))
     for rig in config:
         for camera in rig["cameras"]:
             lens = camera["image_prefix"].rstrip("/")
             camera["camera_model_name"] = model
-            camera["camera_params"] = rough_start(
-                model, width, height, circles[lens], half_field_deg)
+            if spec:
+                camera.pop("camera_params", None)
+                camera["field_of_view_deg"] = 2 * half_field_deg
+                camera["image_circle"] = list(circles[lens])
+            else:
+                camera["camera_params"] = rough_start(
+                    model, width, height, circles[lens][2], half_field_deg)
     with open(path, "w") as f:
         json.dump(config, f, indent=1)
 
 
 def run_system(scene, preset, system, work, program, num_lenses,
-               start=(1.0, False), fit_model="", reuse=""):
+               start=(1.0, False), fit_model="", reuse="", mapper_args=(),
+               spec_start=False):
     """Reconstructs SCENE with SYSTEM; returns a row of results. REUSE: an
     earlier run's folder whose database (features, rig, matches) is mapped
-    again instead of extracting and matching."""
+    again instead of extracting and matching. MAPPER_ARGS: further options
+    of `colmap mapper`. SPEC_START: FIT_MODEL starts from the lenses' field
+    of view and image circle (fitted_rig_config)."""
     import json
     os.makedirs(work)
     logs = os.path.join(work, "logs")
@@ -238,7 +250,7 @@ def run_system(scene, preset, system, work, program, num_lenses,
             # again from FIT_MODEL's rough parameters.
             config = os.path.join(work, "rig_config.json")
             fitted_rig_config(scene, config, fit_model,
-                              PRESET_HALF_FIELD_DEG[preset])
+                              PRESET_HALF_FIELD_DEG[preset], spec_start)
             timed(program, ["rig_configurator", "--database_path", database,
                             "--rig_config_path", config],
                   os.path.join(logs, "rig.log"))
@@ -254,7 +266,7 @@ def run_system(scene, preset, system, work, program, num_lenses,
         config = os.path.join(work, "rig_config.json")
         if fit_model:
             fitted_rig_config(scene, config, fit_model,
-                              PRESET_HALF_FIELD_DEG[preset])
+                              PRESET_HALF_FIELD_DEG[preset], spec_start)
         else:
             rough_rig_config(scene, config, *start)
         t_extract += timed(program, [
@@ -290,7 +302,8 @@ def run_system(scene, preset, system, work, program, num_lenses,
     os.makedirs(sparse)
     t_map = timed(program, ["mapper", "--database_path", database,
                             "--image_path", image_path, "--output_path",
-                            sparse], os.path.join(logs, "map.log"))
+                            sparse, *mapper_args],
+                  os.path.join(logs, "map.log"))
     row.update(t_extract_s=t_extract, t_match_s=t_match, t_map_s=t_map,
                t_total_s=t_extract + t_match + t_map)
     models = sorted(os.listdir(sparse))
@@ -497,6 +510,14 @@ def main():
                         help="the rig starts from this model's rough "
                              "parameters (EUCM, DOUBLE_SPHERE, UNIFIED_OMNI, "
                              "OPENCV_FISHEYE)")
+    parser.add_argument("--start", choices=("generic", "spec"),
+                        default="generic",
+                        help="with --fit_model: generic, the model's generic "
+                             "fisheye shape through the image circle "
+                             "(rough_start); spec, the field of view and the "
+                             "image circle in the rig config, from which "
+                             "rig_configurator fits the model to the "
+                             "equidistant lens")
     parser.add_argument("--supersample", type=int, default=2,
                         help="rays per pixel side of the renders")
     parser.add_argument("--output", default=os.path.join(REPO, "build",
@@ -506,6 +527,9 @@ def main():
                              "run maps that run's database again (mapping "
                              "alone; scenes missing here are rendered again "
                              "for their ground truth)")
+    parser.add_argument("--mapper_args", default="",
+                        help="further options of `colmap mapper`, e.g. "
+                             "\"--Mapper.hold_rig_intrinsics_frames 3\"")
     add_program_arguments(parser)
     parser.add_argument("--upstream_colmap", default=common.UPSTREAM_COLMAP)
     parser.add_argument("--no_upstream", action="store_true")
@@ -584,7 +608,9 @@ def main():
                                      args.fit_model,
                                      os.path.join(args.reuse_database,
                                                   os.path.basename(work))
-                                     if args.reuse_database else "")
+                                     if args.reuse_database else "",
+                                     shlex.split(args.mapper_args),
+                                     args.start == "spec")
                 except (RuntimeError, OSError, ValueError) as error:
                     row = {"preset": preset, "system": system,
                            "error": str(error).splitlines()[0]}

@@ -124,7 +124,8 @@ build_target() {
       local program="build colmap/src/colmap/exe/colmap: "
       sources=("${scene}/reconstruction_io_binary.cc"
                "${scene}/reconstruction_io_text.cc")
-      [ "${target}" = fuzz_rig_config ] && sources=("${scene}/rig.cc")
+      [ "${target}" = fuzz_rig_config ] && sources=("${scene}/rig.cc"
+          "${REPO_ROOT}/colmap_ext/scene/rig_config.cc")
       [ "${target}" = fuzz_database_check ] || [ "${target}" = fuzz_matching ] && sources=(
           "${REPO_ROOT}/colmap_ext/scene/database_check.cc"
           "${REPO_ROOT}/colmap_ext/scene/camera_params_error.cc")
@@ -201,6 +202,9 @@ make_seeds() {
   done
   printf '[{"cameras": [{"image_prefix": "a/", "ref_sensor": true}, %s]}]\n' \
     '{"image_prefix": "b/", "image_suffix": "_2.jpg"}' > "${seeds}/fuzz_rig_config/plain.json"
+  printf '[{"cameras": [{"image_prefix": "a/", "ref_sensor": true, %s}]}]\n' \
+    '"camera_model_name": "EUCM", "field_of_view_deg": 195, "image_circle": [32, 20, 30]' \
+    > "${seeds}/fuzz_rig_config/spec.json"
   cp "${WORK}/scene/images/cam000.jpg" "${seeds}/fuzz_image_bytes/seed.jpg"
   cp "${WORK}/scene_png/images/cam000.png" "${seeds}/fuzz_image_bytes/seed.png"
   local db="${WORK}/seed.db"

@@ -1,5 +1,7 @@
 #include "colmap_ext/scene/rig_config.h"
 
+#include "calibration/camera_presets.h"
+
 #include "colmap/sensor/models.h"
 #include "colmap/util/logging.h"
 
@@ -66,20 +68,51 @@ RigConfig::RigCamera ReadLens(const boost::property_tree::ptree& node,
 
   const auto model_name_node = node.get_child_optional("camera_model_name");
   const auto params_node = node.get_child_optional("camera_params");
-  THROW_CHECK_EQ(model_name_node.has_value(), params_node.has_value())
-      << where << "give camera_model_name and camera_params, or neither";
-  if (model_name_node && params_node) {
-    const std::string model_name = node.get<std::string>("camera_model_name");
-    THROW_CHECK(ExistsCameraModelWithName(model_name))
-        << where << "unknown camera model " << model_name;
-    lens.camera = std::make_optional<Camera>();
-    lens.camera->model_id = CameraModelNameToId(model_name);
-    lens.camera->has_prior_focal_length = true;
+  const auto field_node = node.get_child_optional("field_of_view_deg");
+  const auto circle_node = node.get_child_optional("image_circle");
+  THROW_CHECK_EQ(field_node.has_value(), circle_node.has_value())
+      << where << "give field_of_view_deg and image_circle, or neither";
+  THROW_CHECK(!(params_node && field_node))
+      << where << "give camera_params or field_of_view_deg and image_circle, "
+      << "not both";
+  THROW_CHECK_EQ(model_name_node.has_value(),
+                 params_node.has_value() || field_node.has_value())
+      << where << "give camera_model_name with camera_params (or with "
+      << "field_of_view_deg and image_circle), or none of them";
+  if (!model_name_node) return lens;
+  const std::string model_name = node.get<std::string>("camera_model_name");
+  THROW_CHECK(ExistsCameraModelWithName(model_name))
+      << where << "unknown camera model " << model_name;
+  lens.camera = std::make_optional<Camera>();
+  lens.camera->model_id = CameraModelNameToId(model_name);
+  lens.camera->has_prior_focal_length = true;
+  if (params_node) {
     lens.camera->params = ReadNumbers(params_node.get());
     THROW_CHECK_EQ(lens.camera->params.size(),
                    CameraModelNumParams(lens.camera->model_id))
         << where << "number of camera_params of " << model_name;
+    return lens;
   }
+  // A lens known from its specification: the model fitted to the
+  // equidistant lens whose field of view fills the image circle.
+  const auto field = field_node->get_value_optional<double>();
+  THROW_CHECK(field && field_node->empty())
+      << where << "field_of_view_deg must be a number";
+  const std::vector<double> circle = ReadNumbers(circle_node.get());
+  THROW_CHECK_EQ(circle.size(), 3)
+      << where << "image_circle needs 3 numbers (cx, cy, radius in pixels)";
+  sphera::PresetCamera start;
+  try {
+    start = sphera::EquidistantLensCamera(
+        model_name, {circle[0], circle[1], circle[2]}, *field);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(where + error.what());
+  }
+  lens.camera->params = start.params;
+  LOG(INFO) << where << model_name << " started from the equidistant "
+            << *field << "° lens of its image circle (" << circle[0] << ", "
+            << circle[1] << ", " << circle[2] << "), fit within "
+            << start.fit_max_error_px << " px: " << lens.camera->ParamsToString();
   return lens;
 }
 

@@ -1,11 +1,17 @@
 #include "colmap_ext/scene/rig_config.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
+
+#include "colmap/math/math.h"
 
 namespace colmap {
 namespace {
@@ -79,6 +85,74 @@ TEST(RigConfig, ErrorsNameTheFileAndTheCamera) {
                                   R"([{"cameras": [{"image_prefix": "a/"}]}])"))
                 .find("Rig must have one reference sensor"),
             std::string::npos);
+}
+
+TEST(RigConfig, LensFromItsFieldOfViewAndImageCircle) {
+  // A 195° lens whose circle of radius 560 px the frame crops (its centre
+  // 300 px below the top edge): UNIFIED_OMNI started from the equidistant
+  // lens of that circle, which puts the axis on the circle's centre and the
+  // ray at 97.5° on the circle.
+  const auto path = WriteConfig("spec.json", R"([{"cameras": [
+      {"image_prefix": "a/", "ref_sensor": true,
+       "camera_model_name": "UNIFIED_OMNI", "field_of_view_deg": 195,
+       "image_circle": [800.5, 300, 560]}]}])");
+  const std::vector<RigConfig> configs = ReadCheckedRigConfig(path);
+  ASSERT_TRUE(configs[0].cameras[0].camera.has_value());
+  Camera camera = *configs[0].cameras[0].camera;
+  EXPECT_EQ(camera.ModelName(), "UNIFIED_OMNI");
+  ASSERT_EQ(camera.params.size(), CameraModelNumParams(camera.model_id));
+  camera.width = 1600;
+  camera.height = 1088;
+  const Eigen::Vector2d centre(800.5, 300);
+  const auto pixel_at = [&](double theta_deg) {
+    const double theta = DegToRad(theta_deg);
+    const std::optional<Eigen::Vector2d> pixel = camera.ImgFromCam(
+        Eigen::Vector3d(std::sin(theta), 0, std::cos(theta)));
+    return pixel ? (*pixel - centre).norm() : -1.0;
+  };
+  EXPECT_NEAR(pixel_at(0), 0, 1.0);
+  EXPECT_NEAR(pixel_at(45), 560 * 45 / 97.5, 2.8);
+  EXPECT_NEAR(pixel_at(97.5), 560, 2.8);
+
+  // Each half of the pair, both ways of giving the intrinsics, no model,
+  // and values that start no lens are errors naming the camera.
+  const std::string ref = R"({"image_prefix": "a/", "ref_sensor": true})";
+  const auto error_of = [&](const std::string& name, const std::string& lens) {
+    return ReadError(WriteConfig(name, "[{\"cameras\": [" + ref +
+                                           R"(, {"image_prefix": "b/", )" +
+                                           lens + "}]}]"));
+  };
+  for (const auto& [lens, expected] :
+       std::vector<std::pair<std::string, std::string>>{
+           {R"("camera_model_name": "EUCM", "field_of_view_deg": 190)",
+            "give field_of_view_deg and image_circle, or neither"},
+           {R"("camera_model_name": "EUCM", "image_circle": [1, 2, 3])",
+            "give field_of_view_deg and image_circle, or neither"},
+           {R"("camera_model_name": "EUCM", "camera_params": [1, 1, 1, 1, 0.5,
+              1], "field_of_view_deg": 190, "image_circle": [1, 2, 3])",
+            "not both"},
+           {R"("field_of_view_deg": 190, "image_circle": [1, 2, 3])",
+            "give camera_model_name"},
+           {R"("camera_model_name": "EUCM", "field_of_view_deg": 190,
+              "image_circle": [1, 2])",
+            "image_circle needs 3 numbers"},
+           {R"("camera_model_name": "EUCM", "field_of_view_deg": "wide",
+              "image_circle": [1, 2, 3])",
+            "field_of_view_deg must be a number"},
+           {R"("camera_model_name": "EUCM", "field_of_view_deg": 400,
+              "image_circle": [1, 2, 3])",
+            "field of view"},
+           {R"("camera_model_name": "EUCM", "field_of_view_deg": 190,
+              "image_circle": [1, 2, 0])",
+            "image circle"},
+           {R"("camera_model_name": "PINHOLE", "field_of_view_deg": 90,
+              "image_circle": [1, 2, 3])",
+            "PINHOLE: not a model for"}}) {
+    const std::string error = error_of("lens.json", lens);
+    EXPECT_NE(error.find("camera with image_prefix \"b/\""), std::string::npos)
+        << lens << ": " << error;
+    EXPECT_NE(error.find(expected), std::string::npos) << lens << ": " << error;
+  }
 }
 
 TEST(RigConfig, FrameNameByPrefixAndSuffix) {

@@ -1,5 +1,6 @@
 // libFuzzer target: COLMAP's reader of rig_configurator's JSON file as SPHERA
-// patches it (a bad config is an error naming the file and the camera). The
+// patches it (a bad config is an error naming the file and the camera; a
+// lens given by its field of view and image circle is fitted). The
 // input is the file's content. Whatever the reader throws is an expected
 // outcome; a crash, a leak or undefined behaviour is not (upstream wrote a
 // rotation list of more than 4 numbers past the end of a 4-vector).
@@ -29,11 +30,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const std::vector<colmap::RigConfig> configs = colmap::ReadRigConfig(path);
     // What ApplyRigConfig relies on: one reference camera per rig, poses
-    // with unit quaternions and finite translations.
+    // with unit quaternions and finite translations, finite intrinsics (also
+    // those fitted to a lens given by its field of view and image circle).
     for (const colmap::RigConfig& config : configs) {
       int num_ref = 0;
       for (const auto& camera : config.cameras) {
         num_ref += camera.ref_sensor;
+        if (camera.camera) {
+          for (const double param : camera.camera->params) {
+            if (!std::isfinite(param)) __builtin_trap();
+          }
+        }
         if (camera.cam_from_rig &&
             (std::abs(camera.cam_from_rig->rotation().norm() - 1) > 1e-6 ||
              !camera.cam_from_rig->translation().allFinite())) {
