@@ -13,6 +13,7 @@ of a size the preset does not know is refused, naming it. Those tests are
 skipped, saying so, when the data set is absent; side-by-side frames made
 here are split with the generic preset everywhere."""
 import json
+import math
 import os
 import re
 import sqlite3
@@ -120,7 +121,28 @@ class RigPresetTest(TempDirTestCase):
                     self.assertEqual(camera["camera_model_name"],
                                      "OPENCV_FISHEYE")
             rigs.append(config[0])
+        # And a rig whose lenses give their field of view and image circle
+        # (a circle the 960 x 960 frame crops at the top) in place of
+        # parameters: rig_configurator fits each model to the equidistant
+        # lens of the circle. The database's cameras are made from stand-in
+        # parameters of the frame's size.
+        theta_max = math.radians(100)
+        circle = [480.5, 430.0, 455.0]
+        spec_rig = {"cameras": [
+            {"image_prefix": "spec/lens0/", "ref_sensor": True,
+             "camera_model_name": "OPENCV_FISHEYE",
+             "camera_params": [300, 300, 480, 480, 0, 0, 0, 0]},
+            {"image_prefix": "spec/lens1/",
+             "cam_from_rig_rotation": [0, 0, 1, 0],
+             "cam_from_rig_translation": [0, 0, 0],
+             "camera_model_name": "EUCM",
+             "camera_params": [300, 300, 480, 480, 0.5, 1]}]}
+        rigs.append(spec_rig)
         database = self.make_database(rigs)
+        for camera in spec_rig["cameras"]:
+            del camera["camera_params"]
+            camera["field_of_view_deg"] = 200
+            camera["image_circle"] = circle
         config_path = self.path("all_presets.json")
         with open(config_path, "w") as f:
             json.dump(rigs, f)
@@ -143,13 +165,31 @@ class RigPresetTest(TempDirTestCase):
             by_image = db.images()
             written = db.cameras()
             self.assertEqual(len(set(by_image.values())), num_lenses)
-            for rig in rigs:
+            for rig in rigs[:-1]:
                 for camera in rig["cameras"]:
                     image = image_name(camera, "f1")
                     _, _, _, params = written[by_image[image]]
                     np.testing.assert_allclose(params,
                                                camera["camera_params"],
                                                rtol=1e-12, err_msg=image)
+            # The Kannala-Brandt lens is the equidistant one itself; EUCM
+            # puts the axis on the circle's centre and the rays at 50° and
+            # 100° from it within 0.5% of the equidistant radii.
+            focal = circle[2] / theta_max
+            _, _, _, kb = written[by_image["spec/lens0/f1.jpg"]]
+            np.testing.assert_allclose(
+                kb, [focal, focal, circle[0], circle[1], 0, 0, 0, 0],
+                rtol=1e-6, atol=1e-6)
+            _, _, _, eucm = written[by_image["spec/lens1/f1.jpg"]]
+            np.testing.assert_allclose(eucm[2:4], circle[:2], atol=1e-6)
+            for theta in (theta_max / 2, theta_max):
+                f, alpha, beta = eucm[0], eucm[4], eucm[5]
+                d = math.sqrt(beta * math.sin(theta) ** 2 +
+                              math.cos(theta) ** 2)
+                radius = f * math.sin(theta) / (
+                    alpha * d + (1 - alpha) * math.cos(theta))
+                self.assertAlmostEqual(radius, focal * theta,
+                                       delta=0.005 * circle[2])
         finally:
             db.close()
 
