@@ -13,6 +13,7 @@
 #include "colmap/sensor/models.h"
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <random>
 #include <typeinfo>
@@ -511,6 +512,27 @@ TEST_P(SphereCostFunction, ResidualFollowsTheFocalLength) {
         << "pixel " << pixel->transpose() << " residual "
         << residual.transpose() << " offset " << offset.transpose();
   }
+}
+
+TEST(AngularResidualWeight, NonFiniteMetricTakesTheIsotropicScale) {
+  // A lens whose self-calibration ran away to an infinite focal length:
+  // every pixel still lifts (to the axis), but the camera's metric there is
+  // not finite. The weight takes the one scale instead of an SVD of that
+  // matrix, which need not return (the point filter hung on it).
+  using Model = UnifiedOmniCameraModel;
+  using SphereModel = typename SphereMathOf<Model>::type;
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<double> params = {inf, inf, 512, 512, 1.2, 0, 0, 0, 0};
+  const double pixel[2] = {700, 300};
+  double ray[3];
+  ASSERT_TRUE(SphereModel::RayFromImage(params.data(), pixel, ray));
+  Eigen::Matrix<double, 2, 2, Eigen::RowMajor> metric;
+  ASSERT_TRUE(sphera::PixelFromTangentAtRay<SphereModel>(
+      params.data(), ray, metric.data()));
+  ASSERT_FALSE(metric.allFinite());
+  const AngularWeight weight = AngularResidualWeight<Model>(
+      params.data(), Eigen::Vector2d(pixel[0], pixel[1]));
+  EXPECT_TRUE(weight.isotropic);
 }
 
 INSTANTIATE_TEST_SUITE_P(SphereModels,
